@@ -1,0 +1,89 @@
+//! Command line: what the user typed (clap), turned into validated settings; one
+//! file per subcommand, each a `run(args) -> Result<ExitCode>`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+mod demo;
+mod reduce;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "rocklab",
+    version,
+    about = "Coefficients of restitution of rocking masonry walls from free-vibration tests (Giresini & Croce, COMPDYN 2021)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Reduce a free-vibration campaign: peaks, Eq. 3/4 coefficients, Tables 1–3, plots.
+    Reduce(ReduceArgs),
+    /// Reduce the fixture campaigns shipped in `fixtures/` into `reports/demo/`.
+    Demo(DemoArgs),
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MethodArg {
+    /// Impact-resolved fit of the free-rocking solution (default, no impact bias).
+    Segments,
+    /// Savitzky–Golay derivative and peak picking (classic, biased low at impacts).
+    Savgol,
+}
+
+#[derive(Args, Debug, Clone)]
+pub struct EstimatorArgs {
+    /// Velocity-peak estimator.
+    #[arg(long, value_enum, default_value_t = MethodArg::Segments)]
+    pub method: MethodArg,
+    /// Savitzky–Golay window (odd, samples), with --method savgol.
+    #[arg(long, default_value_t = 11)]
+    pub window: usize,
+    /// Savitzky–Golay polynomial order, with --method savgol.
+    #[arg(long, default_value_t = 3)]
+    pub order: usize,
+    /// Skip the PNG/SVG plots (faster on large campaigns).
+    #[arg(long)]
+    pub no_plots: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ReduceArgs {
+    /// Campaign manifest (TOML, see SPEC).
+    pub manifest: PathBuf,
+    /// Output folder (created; files in it are replaced atomically).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub estimator: EstimatorArgs,
+}
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Fixtures folder holding `campaigns/`.
+    #[arg(long, default_value = "fixtures")]
+    pub fixtures: PathBuf,
+    /// Output folder.
+    #[arg(long, default_value = "reports/demo")]
+    pub out: PathBuf,
+}
+
+pub fn run() -> anyhow::Result<ExitCode> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Reduce(a) => reduce::run(a),
+        Command::Demo(a) => demo::run(a),
+    }
+}
+
+/// Print a line to stdout; a closed pipe (`rocklab … | head`) is not an error.
+pub fn say(line: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{line}");
+}

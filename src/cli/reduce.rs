@@ -1,0 +1,86 @@
+//! `rocklab reduce MANIFEST --out DIR`.
+
+use std::process::ExitCode;
+
+use anyhow::Context;
+
+use super::{say, EstimatorArgs, MethodArg, ReduceArgs};
+use rocklab::ingest::Campaign;
+use rocklab::peaks::{Method, PeakOptions};
+use rocklab::reduce::{reduce_campaign, CampaignResult};
+use rocklab::report;
+use rocklab::signal::savgol::SavGol;
+
+pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
+    let method = match e.method {
+        MethodArg::Segments => Method::Segments,
+        MethodArg::Savgol => {
+            Method::SavGol(SavGol::new(e.window, e.order).map_err(anyhow::Error::msg)?)
+        }
+    };
+    Ok(PeakOptions { n_peaks: 6, method })
+}
+
+pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {
+    let opts = options(&args.estimator)?;
+    let campaign = Campaign::load(&args.manifest)?;
+    let res = reduce_and_write(campaign, opts, &args.out, !args.estimator.no_plots)?;
+    Ok(exit_code(&res))
+}
+
+/// Reduce a campaign, write every output and print the summary; shared by `demo`.
+pub fn reduce_and_write(
+    campaign: Campaign,
+    opts: PeakOptions,
+    out: &std::path::Path,
+    plots: bool,
+) -> anyhow::Result<CampaignResult> {
+    say(&format!(
+        "campaign {} ({}), {} tests; α = {:.4} rad ({}); e_H = {:.4} ({})",
+        campaign.name,
+        campaign.rocking.as_str(),
+        campaign.tests.len(),
+        campaign.alpha_rad,
+        campaign.alpha_source,
+        campaign.e_housner,
+        campaign.e_housner_source
+    ));
+    let res = reduce_campaign(campaign, opts);
+    report::write_reduce_outputs(&res, out, plots)
+        .with_context(|| format!("writing {}", out.display()))?;
+    for t in &res.tests {
+        for w in &t.warnings {
+            eprintln!("warning: test {}: {w}", t.spec.id);
+        }
+    }
+    let tables = report::tables::tables(&res);
+    say(&report::tables::to_markdown(&tables[0]));
+    if !res.means.left_out.is_empty() {
+        say(&format!(
+            "means leave out: {}",
+            res.means
+                .left_out
+                .iter()
+                .map(|(id, why)| format!("{id} ({why})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    say(&format!("wrote {}", out.display()));
+    let failed: Vec<_> = res.failed().collect();
+    if !failed.is_empty() {
+        eprintln!("{} of {} tests failed:", failed.len(), res.tests.len());
+        for (id, e) in failed {
+            eprintln!("  test {id}: {e}");
+        }
+    }
+    Ok(res)
+}
+
+pub fn exit_code(res: &CampaignResult) -> ExitCode {
+    if res.failed().next().is_some() {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}

@@ -1,0 +1,417 @@
+//! Reader of displacement logs: text exports with optional `#` metadata lines, one
+//! header row, then numeric rows; delimiter `,` `;` or tab, decimal `.` or `,`
+//! (given or detected), UTF-8 BOM, CRLF, extra columns ignored.
+//!
+//! The csv crate splits the records (it handles quoting and CRLF and reports line
+//! numbers); numbers are parsed here so that a decimal comma costs no copy of the
+//! file. Every defect is an [`InputError`] naming the file, line and column.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::InputError;
+
+/// Field delimiter of a log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Delimiter {
+    Comma,
+    Semicolon,
+    Tab,
+}
+
+impl Delimiter {
+    fn byte(self) -> u8 {
+        match self {
+            Delimiter::Comma => b',',
+            Delimiter::Semicolon => b';',
+            Delimiter::Tab => b'\t',
+        }
+    }
+    /// The character, for messages.
+    pub fn show(self) -> &'static str {
+        match self {
+            Delimiter::Comma => "','",
+            Delimiter::Semicolon => "';'",
+            Delimiter::Tab => "tab",
+        }
+    }
+}
+
+/// Decimal mark of a log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Decimal {
+    Point,
+    Comma,
+}
+
+/// Delimiter and decimal mark; `None` means detect from the file.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LogFormat {
+    pub delimiter: Option<Delimiter>,
+    pub decimal: Option<Decimal>,
+}
+
+/// The two channels of one log, in seconds and millimetres, outward positive.
+#[derive(Debug, Clone, Default)]
+pub struct LogData {
+    pub time_s: Vec<f64>,
+    /// Displacement at the sensor, mm, positive OUTWARD (the file's sign × outward_sign).
+    pub disp_mm: Vec<f64>,
+    /// What was read and how, e.g. "delimiter ';' (detected)".
+    pub notes: Vec<String>,
+    /// Every warning raised while reading (a dropped truncated line, …).
+    pub warnings: Vec<String>,
+}
+
+/// Builder of a log reader: `LogReader::new(path).time("time_s", 1.0)…read()`.
+#[derive(Debug, Clone)]
+pub struct LogReader {
+    path: PathBuf,
+    format: LogFormat,
+    time_column: String,
+    time_scale: f64,
+    disp_column: String,
+    disp_scale: f64,
+}
+
+impl LogReader {
+    /// Defaults: columns `time_s` (s) and `disp_mm` (mm), outward sign +1, format
+    /// detected.
+    pub fn new(path: impl Into<PathBuf>) -> Self {
+        LogReader {
+            path: path.into(),
+            format: LogFormat::default(),
+            time_column: "time_s".into(),
+            time_scale: 1.0,
+            disp_column: "disp_mm".into(),
+            disp_scale: 1.0,
+        }
+    }
+    pub fn format(mut self, f: LogFormat) -> Self {
+        self.format = f;
+        self
+    }
+    /// Time column and its factor to seconds.
+    pub fn time(mut self, column: &str, to_s: f64) -> Self {
+        self.time_column = column.into();
+        self.time_scale = to_s;
+        self
+    }
+    /// Displacement column and its factor to outward millimetres (unit × outward_sign).
+    pub fn displacement(mut self, column: &str, to_outward_mm: f64) -> Self {
+        self.disp_column = column.into();
+        self.disp_scale = to_outward_mm;
+        self
+    }
+
+    /// Read the file.
+    pub fn read(&self) -> Result<LogData, InputError> {
+        let bytes = std::fs::read(&self.path).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::NotFound {
+                InputError::Missing {
+                    file: self.path.clone(),
+                }
+            } else {
+                InputError::Io {
+                    file: self.path.clone(),
+                    source: e,
+                }
+            }
+        })?;
+        self.parse(&bytes)
+    }
+
+    /// Parse the bytes of a log (the path only names it in messages).
+    pub fn parse(&self, bytes: &[u8]) -> Result<LogData, InputError> {
+        let file = &self.path;
+        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+        if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+            return Err(InputError::Empty { file: file.clone() });
+        }
+        let mut data = LogData::default();
+        let (delimiter, decimal) = self.resolve_format(bytes, &mut data.notes)?;
+        let mut rdr = csv::ReaderBuilder::new()
+            .delimiter(delimiter.byte())
+            .has_headers(false)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .from_reader(bytes);
+        let mut rec = csv::ByteRecord::new();
+        let read = |rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord| {
+            rdr.read_byte_record(rec).map_err(|e| InputError::File {
+                file: file.clone(),
+                message: format!("not readable as delimited text: {e}"),
+            })
+        };
+        // Header row.
+        if !read(&mut rdr, &mut rec)? {
+            return Err(InputError::File {
+                file: file.clone(),
+                message: "only '#' metadata lines: expected a header row and numeric rows".into(),
+            });
+        }
+        let header_line = rec.position().map_or(0, |p| p.line());
+        let names: Vec<String> = rec
+            .iter()
+            .map(|f| String::from_utf8_lossy(f).trim().to_string())
+            .collect();
+        let find = |name: &str, what: &str| {
+            names.iter().position(|n| n == name).ok_or_else(|| InputError::Line {
+                file: file.clone(),
+                line: header_line,
+                message: format!(
+                    "{what} column '{name}' not found (columns: {}). Set [channels].{what}.column or override it in this [[test]]",
+                    names.join(", ")
+                ),
+            })
+        };
+        let it = find(&self.time_column, "time")?;
+        let id = find(&self.disp_column, "displacement")?;
+        let need = it.max(id) + 1;
+        let ends_with_newline = bytes.last().is_some_and(|b| *b == b'\n' || *b == b'\r');
+        let approx_rows = bytes.len() / 16;
+        data.time_s.reserve(approx_rows);
+        data.disp_mm.reserve(approx_rows);
+        let mut pending: Option<(u64, InputError)> = None;
+        let mut buf = Vec::with_capacity(32);
+        while read(&mut rdr, &mut rec)? {
+            let line = rec.position().map_or(0, |p| p.line());
+            if let Some((_, e)) = pending.take() {
+                // A defect that was not on the last line is an error.
+                return Err(e);
+            }
+            if rec.len() == 1 && rec.get(0).is_some_and(|f| f.is_empty()) {
+                continue; // blank line
+            }
+            let row = (|| {
+                if rec.len() < need {
+                    return Err(InputError::At {
+                        file: file.clone(),
+                        line,
+                        column: rec.len() + 1,
+                        message: format!(
+                            "row has {} fields, the header has {}: expected a value for column '{}'",
+                            rec.len(),
+                            names.len(),
+                            if rec.len() <= it { &self.time_column } else { &self.disp_column }
+                        ),
+                    });
+                }
+                let t = parse_cell(rec.get(it).unwrap_or(b""), decimal, &mut buf)
+                    .map_err(|m| at(file, line, it, &self.time_column, m))?;
+                let x = parse_cell(rec.get(id).unwrap_or(b""), decimal, &mut buf)
+                    .map_err(|m| at(file, line, id, &self.disp_column, m))?;
+                Ok((t * self.time_scale, x * self.disp_scale, t))
+            })();
+            match row {
+                Ok((t, x, t_raw)) => {
+                    if let Some(&prev) = data.time_s.last() {
+                        if t <= prev {
+                            let what = if t == prev {
+                                "duplicated"
+                            } else {
+                                "decreasing"
+                            };
+                            return Err(at(
+                                file,
+                                line,
+                                it,
+                                &self.time_column,
+                                format!(
+                                    "time {t_raw} is {what} (previous row {}): expected strictly increasing time",
+                                    prev / self.time_scale
+                                ),
+                            ));
+                        }
+                    }
+                    data.time_s.push(t);
+                    data.disp_mm.push(x);
+                }
+                Err(e) => pending = Some((line, e)),
+            }
+        }
+        if let Some((line, e)) = pending {
+            if ends_with_newline {
+                return Err(e);
+            }
+            data.warnings.push(format!(
+                "{}:{line}: truncated last line (no line end, {e_short}) dropped",
+                file.display(),
+                e_short = short(&e)
+            ));
+        }
+        if data.time_s.is_empty() {
+            return Err(InputError::NoData {
+                file: file.clone(),
+                line: header_line,
+            });
+        }
+        Ok(data)
+    }
+
+    fn resolve_format(
+        &self,
+        bytes: &[u8],
+        notes: &mut Vec<String>,
+    ) -> Result<(Delimiter, Decimal), InputError> {
+        let mut lines = bytes
+            .split(|b| *b == b'\n')
+            .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
+            .filter(|l| !l.is_empty() && l[0] != b'#');
+        let header = lines.next().unwrap_or(b"");
+        let sample: Vec<&[u8]> = lines.take(50).collect();
+        let delimiter = match self.format.delimiter {
+            Some(d) => {
+                notes.push(format!("delimiter {} (manifest)", d.show()));
+                d
+            }
+            None => {
+                let d = if header.contains(&b'\t') {
+                    Delimiter::Tab
+                } else if header.contains(&b';') {
+                    Delimiter::Semicolon
+                } else if header.contains(&b',') {
+                    Delimiter::Comma
+                } else {
+                    return Err(InputError::File {
+                        file: self.path.clone(),
+                        message: "cannot detect the delimiter: the header row has no ',', ';' or tab. Set [format].delimiter".into(),
+                    });
+                };
+                notes.push(format!("delimiter {} (detected from the header)", d.show()));
+                d
+            }
+        };
+        let decimal = match self.format.decimal {
+            Some(d) => {
+                notes.push(format!("decimal {:?} (manifest)", d));
+                d
+            }
+            None => {
+                let d = if delimiter != Delimiter::Comma && sample.iter().any(|l| l.contains(&b','))
+                {
+                    Decimal::Comma
+                } else {
+                    Decimal::Point
+                };
+                notes.push(format!("decimal {:?} (detected from the first rows)", d));
+                d
+            }
+        };
+        Ok((delimiter, decimal))
+    }
+}
+
+fn short(e: &InputError) -> String {
+    match e {
+        InputError::At { message, .. } => message.clone(),
+        other => other.to_string(),
+    }
+}
+
+fn at(file: &Path, line: u64, col0: usize, name: &str, message: String) -> InputError {
+    InputError::At {
+        file: file.to_path_buf(),
+        line,
+        column: col0 + 1,
+        message: format!("column '{name}': {message}"),
+    }
+}
+
+/// Parse one numeric cell with the given decimal mark; finite values only.
+fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, String> {
+    let text = match decimal {
+        Decimal::Point => cell,
+        Decimal::Comma => {
+            buf.clear();
+            buf.extend(cell.iter().map(|&b| if b == b',' { b'.' } else { b }));
+            buf.as_slice()
+        }
+    };
+    let shown = || String::from_utf8_lossy(cell).into_owned();
+    if text.is_empty() {
+        return Err("empty cell: expected a number".into());
+    }
+    let s = std::str::from_utf8(text)
+        .map_err(|_| format!("'{}' is not text: expected a number", shown()))?;
+    let v: f64 = s.parse().map_err(|_| {
+        let hint = match decimal {
+            Decimal::Point if s.contains(',') => " (a decimal comma? set [format].decimal = \",\")",
+            _ => "",
+        };
+        format!("'{}' is not a number{hint}", shown())
+    })?;
+    if !v.is_finite() {
+        return Err(format!(
+            "'{}' is not a finite number: expected a measured value",
+            shown()
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reader() -> LogReader {
+        LogReader::new("t.csv")
+    }
+
+    #[test]
+    fn reads_metadata_header_and_rows() {
+        let d = reader()
+            .parse(b"# a\n# b\ntime_s,disp_mm,acc\n0.0,1.5,9\n0.005,1.25,9\n")
+            .unwrap();
+        assert_eq!(d.time_s, vec![0.0, 0.005]);
+        assert_eq!(d.disp_mm, vec![1.5, 1.25]);
+    }
+
+    #[test]
+    fn detects_semicolon_and_decimal_comma_with_bom_and_crlf() {
+        let d = reader()
+            .parse("\u{feff}time_s;disp_mm\r\n0,000;1,5\r\n0,005;-2,25\r\n".as_bytes())
+            .unwrap();
+        assert_eq!(d.time_s, vec![0.0, 0.005]);
+        assert_eq!(d.disp_mm, vec![1.5, -2.25]);
+        assert!(d.notes.iter().any(|n| n.contains("detected")));
+    }
+
+    #[test]
+    fn tab_delimited() {
+        let d = reader().parse(b"disp_mm\ttime_s\n1\t0\n2\t1\n").unwrap();
+        assert_eq!(d.disp_mm, vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn scales_units_and_sign() {
+        let d = LogReader::new("x")
+            .time("t", 1e-3)
+            .displacement("d", -1e3)
+            .parse(b"t,d\n0,0.001\n5,0.002\n")
+            .unwrap();
+        assert_eq!(d.time_s, vec![0.0, 0.005]);
+        assert_eq!(d.disp_mm, vec![-1.0, -2.0]);
+    }
+
+    #[test]
+    fn non_numeric_cell_names_line_and_column() {
+        let e = reader()
+            .parse(b"#m\ntime_s,disp_mm\n0,1\n0.1,abc\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("t.csv:4:2"), "{e}");
+        assert!(e.contains("'abc' is not a number"), "{e}");
+    }
+
+    #[test]
+    fn truncated_last_line_is_dropped_with_a_warning() {
+        let d = reader().parse(b"time_s,disp_mm\n0,1\n0.1,2\n0.2").unwrap();
+        assert_eq!(d.time_s.len(), 2);
+        assert!(
+            d.warnings[0].contains(":4: truncated last line"),
+            "{:?}",
+            d.warnings
+        );
+    }
+}

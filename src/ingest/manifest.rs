@@ -1,0 +1,492 @@
+//! The campaign manifest (SPEC "Campaign manifest"): parsed in two stages, the raw
+//! TOML (unknown keys rejected by name) and a validated [`Campaign`] with the
+//! `[channels]` defaults merged into every test and α, e_H chosen with provenance.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::ingest::log::{Decimal, Delimiter, LogFormat};
+use crate::wall::{housner_e, p_squared_rectangular, slenderness, Provenance};
+
+/// One-sided (transverse walls restrain the inward side) or two-sided rocking.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Rocking {
+    OneSided,
+    TwoSided,
+}
+
+impl Rocking {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Rocking::OneSided => "one-sided",
+            Rocking::TwoSided => "two-sided",
+        }
+    }
+}
+
+/// Unit of the time column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TimeUnit {
+    S,
+    Ms,
+}
+
+impl TimeUnit {
+    /// Factor to seconds.
+    pub fn to_s(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+        }
+    }
+}
+
+/// Unit of the displacement column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LengthUnit {
+    Mm,
+    M,
+}
+
+impl LengthUnit {
+    /// Factor to millimetres.
+    pub fn to_mm(self) -> f64 {
+        match self {
+            LengthUnit::Mm => 1.0,
+            LengthUnit::M => 1e3,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawManifest {
+    campaign: RawCampaign,
+    wall: RawWall,
+    channels: Option<RawChannels>,
+    format: Option<RawFormat>,
+    #[serde(default)]
+    test: Vec<RawTest>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCampaign {
+    name: String,
+    rocking: Rocking,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(non_snake_case)]
+struct RawWall {
+    height_m: f64,
+    thickness_m: f64,
+    width_m: Option<f64>,
+    weight_kN: Option<f64>,
+    #[serde(default)]
+    hinge_height_m: f64,
+    alpha_rad: Option<f64>,
+    e_housner: Option<f64>,
+}
+
+/// A time channel: column name and unit.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TimeChannel {
+    pub column: String,
+    pub unit: TimeUnit,
+}
+
+/// A displacement channel: column name, unit and the sensor height above the base.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct DisplacementChannel {
+    pub column: String,
+    pub unit: LengthUnit,
+    pub height_m: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawChannels {
+    time: Option<TimeChannel>,
+    displacement: Option<DisplacementChannel>,
+    outward_sign: Option<i64>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFormat {
+    delimiter: Option<String>,
+    decimal: Option<String>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTest {
+    id: String,
+    file: String,
+    imposed_displacement_mm: Option<f64>,
+    #[serde(default)]
+    exclude_from_mean: bool,
+    time: Option<TimeChannel>,
+    displacement: Option<DisplacementChannel>,
+    outward_sign: Option<i64>,
+    channels: Option<RawChannels>,
+    format: Option<RawFormat>,
+}
+
+/// A validated test: every channel resolved.
+#[derive(Debug, Clone)]
+pub struct TestSpec {
+    pub id: String,
+    /// Absolute or manifest-relative path, resolved against the manifest's folder.
+    pub file: PathBuf,
+    pub imposed_displacement_mm: Option<f64>,
+    pub exclude_from_mean: bool,
+    pub time: TimeChannel,
+    pub displacement: DisplacementChannel,
+    /// +1 when a positive reading means outward, −1 when it means inward.
+    pub outward_sign: f64,
+    pub format: LogFormat,
+    /// Lever arm of the sensor about the hinge, m (sensor height − hinge height).
+    pub lever_arm_m: f64,
+}
+
+/// A validated campaign.
+#[derive(Debug, Clone)]
+pub struct Campaign {
+    pub name: String,
+    pub rocking: Rocking,
+    pub manifest_path: PathBuf,
+    pub height_m: f64,
+    pub thickness_m: f64,
+    pub width_m: Option<f64>,
+    pub weight_kn: Option<f64>,
+    pub hinge_height_m: f64,
+    /// α for e_H (SPEC: atan(thickness / height) of the wall as given).
+    pub alpha_rad: f64,
+    pub alpha_source: Provenance,
+    /// e_H, paper Eq. 2, or the manifest's override.
+    pub e_housner: f64,
+    pub e_housner_source: Provenance,
+    pub tests: Vec<TestSpec>,
+}
+
+impl Campaign {
+    /// Height of the rocking part above the hinge, m.
+    pub fn rocking_height_m(&self) -> f64 {
+        self.height_m - self.hinge_height_m
+    }
+
+    /// Slenderness of the rocking part above the hinge (used as a starting value of
+    /// the physics-based velocity estimator, which then fits it).
+    pub fn alpha_dynamic(&self) -> f64 {
+        slenderness(self.thickness_m, self.rocking_height_m())
+    }
+
+    /// p² of the rocking part above the hinge (rectangular block), s⁻².
+    pub fn p_squared(&self) -> f64 {
+        p_squared_rectangular(self.rocking_height_m(), self.thickness_m)
+    }
+
+    /// Read and validate a manifest file.
+    pub fn load(path: &Path) -> anyhow::Result<Campaign> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::NotFound {
+                anyhow::anyhow!("{}: manifest not found", path.display())
+            } else {
+                anyhow::anyhow!("{}: cannot read manifest: {e}", path.display())
+            }
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parse and validate manifest text; `path` names it in errors and resolves the
+    /// test files.
+    pub fn parse(text: &str, path: &Path) -> anyhow::Result<Campaign> {
+        let raw: RawManifest = toml::from_str(text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        validate(raw, path)
+    }
+}
+
+fn bad(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error {
+    anyhow::anyhow!("{}: {msg}", path.display())
+}
+
+fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(bad(
+            path,
+            format!("{key} = {v}: expected a positive number"),
+        ))
+    }
+}
+
+fn sign(path: &Path, where_: &str, v: i64) -> anyhow::Result<f64> {
+    match v {
+        1 => Ok(1.0),
+        -1 => Ok(-1.0),
+        _ => Err(bad(
+            path,
+            format!("{where_}outward_sign = {v}: expected 1 or -1"),
+        )),
+    }
+}
+
+fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> anyhow::Result<LogFormat> {
+    let delimiter = match f.delimiter.as_deref() {
+        None => None,
+        Some(",") => Some(Delimiter::Comma),
+        Some(";") => Some(Delimiter::Semicolon),
+        Some("\t") | Some("\\t") | Some("tab") => Some(Delimiter::Tab),
+        Some(other) => {
+            return Err(bad(
+                path,
+                format!("{where_}delimiter = {other:?}: expected \",\", \";\" or \"\\t\""),
+            ))
+        }
+    };
+    let decimal = match f.decimal.as_deref() {
+        None => None,
+        Some(".") => Some(Decimal::Point),
+        Some(",") => Some(Decimal::Comma),
+        Some(other) => {
+            return Err(bad(
+                path,
+                format!("{where_}decimal = {other:?}: expected \".\" or \",\""),
+            ))
+        }
+    };
+    if delimiter == Some(Delimiter::Comma) && decimal == Some(Decimal::Comma) {
+        return Err(bad(
+            path,
+            format!("{where_}delimiter and decimal are both \",\": a log cannot be read that way"),
+        ));
+    }
+    Ok(LogFormat { delimiter, decimal })
+}
+
+fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
+    let w = &raw.wall;
+    let height_m = positive(path, "[wall].height_m", w.height_m)?;
+    let thickness_m = positive(path, "[wall].thickness_m", w.thickness_m)?;
+    if !(w.hinge_height_m.is_finite() && w.hinge_height_m >= 0.0 && w.hinge_height_m < height_m) {
+        return Err(bad(
+            path,
+            format!(
+                "[wall].hinge_height_m = {}: expected 0 ≤ hinge < height ({height_m})",
+                w.hinge_height_m
+            ),
+        ));
+    }
+    let (alpha_rad, alpha_source) = match w.alpha_rad {
+        Some(a) => {
+            if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+                return Err(bad(
+                    path,
+                    format!("[wall].alpha_rad = {a}: expected 0 < α < π/2"),
+                ));
+            }
+            (a, Provenance::Override("[wall].alpha_rad".into()))
+        }
+        None => (
+            slenderness(thickness_m, height_m),
+            Provenance::Computed(format!("atan({thickness_m} / {height_m})")),
+        ),
+    };
+    let (e_housner, e_housner_source) = match w.e_housner {
+        Some(e) => {
+            if !(e > 0.0 && e <= 1.0) {
+                return Err(bad(
+                    path,
+                    format!("[wall].e_housner = {e}: expected 0 < e_H ≤ 1"),
+                ));
+            }
+            (e, Provenance::Override("[wall].e_housner".into()))
+        }
+        None => (
+            housner_e(alpha_rad),
+            Provenance::Computed(format!("Eq. 2, 1 − 1.5 sin²({alpha_rad:.4})")),
+        ),
+    };
+    let defaults = raw.channels.clone().unwrap_or_default();
+    let campaign_format = match &raw.format {
+        Some(f) => parse_format(path, "[format].", f)?,
+        None => LogFormat::default(),
+    };
+    let base = path.parent().unwrap_or_else(|| Path::new("."));
+    if raw.test.is_empty() {
+        return Err(bad(path, "no [[test]] entries: expected at least one test"));
+    }
+    let mut tests = Vec::with_capacity(raw.test.len());
+    let mut seen = std::collections::HashSet::new();
+    for t in &raw.test {
+        let where_ = format!("[[test]] id = {:?}: ", t.id);
+        if t.id.trim().is_empty() {
+            return Err(bad(path, "[[test]] with an empty id"));
+        }
+        if !seen.insert(t.id.clone()) {
+            return Err(bad(path, format!("{where_}duplicate test id")));
+        }
+        let nested = t.channels.clone().unwrap_or_default();
+        let time = t
+            .time
+            .clone()
+            .or(nested.time)
+            .or(defaults.time.clone())
+            .ok_or_else(|| {
+                bad(
+                    path,
+                    format!(
+                        "{where_}no time channel: set [channels].time or time in this [[test]]"
+                    ),
+                )
+            })?;
+        let displacement = t
+            .displacement
+            .clone()
+            .or(nested.displacement)
+            .or(defaults.displacement.clone())
+            .ok_or_else(|| {
+                bad(path, format!("{where_}no displacement channel: set [channels].displacement or displacement in this [[test]]"))
+            })?;
+        let outward_sign = sign(
+            path,
+            &where_,
+            t.outward_sign
+                .or(nested.outward_sign)
+                .or(defaults.outward_sign)
+                .unwrap_or(1),
+        )?;
+        let sensor_h = displacement.height_m.ok_or_else(|| {
+            bad(path, format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"))
+        })?;
+        let sensor_h = positive(path, "displacement.height_m", sensor_h)?;
+        let lever_arm_m = sensor_h - w.hinge_height_m;
+        if lever_arm_m <= 0.0 {
+            return Err(bad(
+                path,
+                format!(
+                    "{where_}sensor height {sensor_h} m is not above the hinge ({} m)",
+                    w.hinge_height_m
+                ),
+            ));
+        }
+        let format = match &t.format {
+            Some(f) => parse_format(path, &format!("{where_}format."), f)?,
+            None => campaign_format,
+        };
+        if let Some(d) = t.imposed_displacement_mm {
+            positive(path, "imposed_displacement_mm", d)?;
+        }
+        tests.push(TestSpec {
+            id: t.id.clone(),
+            file: base.join(&t.file),
+            imposed_displacement_mm: t.imposed_displacement_mm,
+            exclude_from_mean: t.exclude_from_mean,
+            time,
+            displacement,
+            outward_sign,
+            format,
+            lever_arm_m,
+        });
+    }
+    Ok(Campaign {
+        name: raw.campaign.name,
+        rocking: raw.campaign.rocking,
+        manifest_path: path.to_path_buf(),
+        height_m,
+        thickness_m,
+        width_m: w.width_m,
+        weight_kn: w.weight_kN,
+        hinge_height_m: w.hinge_height_m,
+        alpha_rad,
+        alpha_source,
+        e_housner,
+        e_housner_source,
+        tests,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BASE: &str = r#"
+[campaign]
+name = "c"
+rocking = "one-sided"
+[wall]
+height_m = 2.70
+thickness_m = 0.36
+hinge_height_m = 0.23
+[channels]
+time = { column = "time_s", unit = "s" }
+displacement = { column = "disp_mm", unit = "mm", height_m = 2.56 }
+outward_sign = 1
+[[test]]
+id = "a"
+file = "a.csv"
+[[test]]
+id = "b"
+file = "b.csv"
+outward_sign = -1
+time = { column = "t_ms", unit = "ms" }
+"#;
+
+    #[test]
+    fn defaults_merge_with_overrides() {
+        let c = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
+        assert_eq!(c.tests[0].time.column, "time_s");
+        assert_eq!(c.tests[1].time.column, "t_ms");
+        assert_eq!(c.tests[1].time.unit, TimeUnit::Ms);
+        assert_eq!(c.tests[1].outward_sign, -1.0);
+        assert_eq!(c.tests[1].displacement.column, "disp_mm");
+        assert!((c.tests[0].lever_arm_m - 2.33).abs() < 1e-12);
+        assert_eq!(c.tests[0].file, Path::new("/x/a.csv"));
+        assert!(matches!(c.alpha_source, Provenance::Computed(_)));
+        assert!((c.e_housner - 0.9738).abs() < 1e-4);
+    }
+
+    #[test]
+    fn unknown_key_is_named() {
+        let text = BASE.replace("hinge_height_m = 0.23", "hinge_height_m = 0.23\nhieght = 3");
+        let err = Campaign::parse(&text, Path::new("m.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("hieght"), "{err}");
+        assert!(err.contains("m.toml"), "{err}");
+    }
+
+    #[test]
+    fn overrides_are_recorded() {
+        let text = BASE.replace(
+            "hinge_height_m = 0.23",
+            "hinge_height_m = 0.23\nalpha_rad = 0.12\ne_housner = 0.97",
+        );
+        let c = Campaign::parse(&text, Path::new("m.toml")).unwrap();
+        assert_eq!(c.alpha_rad, 0.12);
+        assert_eq!(c.e_housner, 0.97);
+        assert!(matches!(c.e_housner_source, Provenance::Override(_)));
+    }
+
+    #[test]
+    fn bad_sign_and_format_are_rejected() {
+        let text = BASE.replace("outward_sign = -1", "outward_sign = 2");
+        let err = Campaign::parse(&text, Path::new("m.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("outward_sign = 2"), "{err}");
+        let text = format!("{BASE}\n[format]\ndelimiter = \"|\"\n");
+        assert!(Campaign::parse(&text, Path::new("m.toml")).is_err());
+    }
+}

@@ -1,0 +1,127 @@
+//! The per-test reduction pipeline: read the log, find the release, impacts and
+//! velocity peaks, compute the coefficients. One `Result` per test, so one broken
+//! test never stops the others.
+
+use rayon::prelude::*;
+
+use crate::ingest::manifest::{Campaign, TestSpec};
+use crate::ingest::{LogData, LogReader};
+use crate::peaks::{analyse, Analysis, PeakOptions, Physics};
+use crate::restitution::{coefficients, Coefficients};
+use crate::tables::{campaign_means, CampaignMeans, Row};
+
+/// A reduced test.
+#[derive(Debug, Clone)]
+pub struct Reduced {
+    pub log: LogData,
+    pub analysis: Analysis,
+    pub coefficients: Coefficients,
+}
+
+/// The outcome of one test.
+#[derive(Debug)]
+pub struct TestOutcome {
+    pub spec: TestSpec,
+    pub result: Result<Reduced, String>,
+    /// Warnings raised while reading (kept even when the reduction failed later).
+    pub warnings: Vec<String>,
+}
+
+/// A reduced campaign.
+#[derive(Debug)]
+pub struct CampaignResult {
+    pub campaign: Campaign,
+    pub options: PeakOptions,
+    pub tests: Vec<TestOutcome>,
+    pub means: CampaignMeans,
+}
+
+impl CampaignResult {
+    pub fn failed(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.tests.iter().filter_map(|t| {
+            t.result
+                .as_ref()
+                .err()
+                .map(|e| (t.spec.id.as_str(), e.as_str()))
+        })
+    }
+}
+
+/// The physics the estimator starts from, for one test of a campaign.
+pub fn physics(campaign: &Campaign, spec: &TestSpec) -> Physics {
+    Physics {
+        rocking: campaign.rocking,
+        lever_arm_mm: spec.lever_arm_m * 1e3,
+        p_guess: campaign.p_squared().sqrt(),
+    }
+}
+
+/// Read one log as its manifest entry says.
+pub fn read_log(spec: &TestSpec) -> Result<LogData, String> {
+    LogReader::new(&spec.file)
+        .format(spec.format)
+        .time(&spec.time.column, spec.time.unit.to_s())
+        .displacement(
+            &spec.displacement.column,
+            spec.displacement.unit.to_mm() * spec.outward_sign,
+        )
+        .read()
+        .map_err(|e| e.to_string())
+}
+
+/// Reduce one test.
+pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) -> TestOutcome {
+    let log = match read_log(spec) {
+        Ok(l) => l,
+        Err(e) => {
+            return TestOutcome {
+                spec: spec.clone(),
+                result: Err(e),
+                warnings: Vec::new(),
+            }
+        }
+    };
+    let warnings = log.warnings.clone();
+    let file = spec.file.display().to_string();
+    let result = analyse(&log.time_s, &log.disp_mm, &physics(campaign, spec), options)
+        .map_err(|e| format!("{file}: {e}"))
+        .and_then(|analysis| {
+            let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
+            let c = coefficients(&v, campaign.e_housner)
+                .ok_or_else(|| format!("{file}: too few peaks (n = {} < 6)", v.len()))?;
+            Ok(Reduced {
+                log,
+                analysis,
+                coefficients: c,
+            })
+        });
+    TestOutcome {
+        spec: spec.clone(),
+        result,
+        warnings,
+    }
+}
+
+/// Reduce every test of a campaign (in parallel) and compute the means.
+pub fn reduce_campaign(campaign: Campaign, options: PeakOptions) -> CampaignResult {
+    let tests: Vec<TestOutcome> = campaign
+        .tests
+        .par_iter()
+        .map(|s| reduce_test(&campaign, s, &options))
+        .collect();
+    let rows: Vec<Row> = tests
+        .iter()
+        .map(|t| Row {
+            id: t.spec.id.clone(),
+            exclude_from_mean: t.spec.exclude_from_mean,
+            coefficients: t.result.as_ref().ok().map(|r| r.coefficients),
+        })
+        .collect();
+    let means = campaign_means(&rows);
+    CampaignResult {
+        campaign,
+        options,
+        tests,
+        means,
+    }
+}

@@ -1,0 +1,192 @@
+//! Plots in PNG and SVG (plotters). Text is drawn with the DejaVu Sans font shipped
+//! in `fixtures/fonts` through plotters' `ab_glyph` backend, so no system font
+//! library is needed. Every file is written atomically.
+
+use std::path::Path;
+use std::sync::Once;
+
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::atomic::write_atomic;
+
+static FONT: &[u8] = include_bytes!("../../fixtures/fonts/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+/// Register the shipped font as "sans-serif" (once per process).
+pub fn register_font() {
+    REGISTER.call_once(|| {
+        for style in [
+            FontStyle::Normal,
+            FontStyle::Bold,
+            FontStyle::Italic,
+            FontStyle::Oblique,
+        ] {
+            let _ = plotters::style::register_font("sans-serif", style, FONT);
+        }
+    });
+}
+
+fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("plot: {e:?}")
+}
+
+/// A line series: label, colour, points.
+pub struct Series {
+    pub label: String,
+    pub color: RGBColor,
+    pub points: Vec<(f64, f64)>,
+    /// Draw as markers instead of a line.
+    pub markers: bool,
+}
+
+/// One panel: title, axis labels, series, optional horizontal line (value, label).
+pub struct Panel {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub hline: Option<(f64, String)>,
+}
+
+fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
+    let mut xs = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut ys = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in &panel.series {
+        for &(x, y) in &s.points {
+            if x.is_finite() && y.is_finite() {
+                xs = (xs.0.min(x), xs.1.max(x));
+                ys = (ys.0.min(y), ys.1.max(y));
+            }
+        }
+    }
+    if let Some((h, _)) = panel.hline {
+        ys = (ys.0.min(h), ys.1.max(h));
+    }
+    if !xs.0.is_finite() {
+        xs = (0.0, 1.0);
+        ys = (0.0, 1.0);
+    }
+    let pad = |(a, b): (f64, f64), f: f64| {
+        let w = (b - a).abs().max(1e-9);
+        (a - f * w, b + f * w)
+    };
+    (pad(xs, 0.01), pad(ys, 0.08))
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let ((x0, x1), (y0, y1)) = bounds(panel);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, ("sans-serif", 18))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(panel.x_label.as_str())
+        .y_desc(panel.y_label.as_str())
+        .label_style(("sans-serif", 13))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    for s in &panel.series {
+        let color = s.color;
+        if s.markers {
+            chart
+                .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .map_err(err)?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+        } else {
+            chart
+                .draw_series(LineSeries::new(
+                    s.points.iter().copied(),
+                    color.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(s.label.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+        }
+    }
+    if let Some((h, label)) = &panel.hline {
+        let blue = RGBColor(31, 119, 180);
+        chart
+            .draw_series(LineSeries::new(
+                vec![(x0, *h), (x1, *h)],
+                blue.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(label.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2))
+            });
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+fn draw_figure<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, panels: &[Panel]) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let areas = root.split_evenly((panels.len(), 1));
+    for (a, p) in areas.iter().zip(panels) {
+        draw_panel(a, p)?;
+    }
+    root.present().map_err(err)?;
+    Ok(())
+}
+
+/// Render stacked panels to `stem.png` and `stem.svg` (atomically).
+pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) -> Result<()> {
+    register_font();
+    let size = (width, height_per_panel * panels.len() as u32);
+    let mut svg = String::new();
+    draw_figure(
+        SVGBackend::with_string(&mut svg, size).into_drawing_area(),
+        panels,
+    )?;
+    write_atomic(&stem.with_extension("svg"), svg.as_bytes())?;
+    let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
+    draw_figure(
+        BitMapBackend::with_buffer(&mut buf, size).into_drawing_area(),
+        panels,
+    )?;
+    let png = encode_png(&buf, size.0, size.1)?;
+    write_atomic(&stem.with_extension("png"), &png)?;
+    Ok(())
+}
+
+/// Encode an RGB buffer as PNG (through the `image` crate that plotters' bitmap
+/// encoder already brings).
+fn encode_png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, w, h, image::ColorType::Rgb8)
+        .map_err(err)?;
+    Ok(out)
+}
+
+pub const BLACKISH: RGBColor = RGBColor(40, 40, 40);
+pub const GREY: RGBColor = RGBColor(150, 150, 150);
+pub const RED: RGBColor = RGBColor(214, 39, 40);
+pub const BLUE: RGBColor = RGBColor(31, 119, 180);
+pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
+pub const GREEN: RGBColor = RGBColor(44, 160, 44);

@@ -1,0 +1,104 @@
+//! Coefficients of restitution from the velocity peaks (paper Eqs. 3–6, SPEC table).
+//!
+//! v_0, v_1, … are the velocity peaks after release, alternating in sign, v_0 the
+//! first (inward) one; v_{k+1}/v_k is the coefficient of the impact after peak k.
+
+/// The quantities of one test (first six peaks).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Coefficients {
+    /// Eq. 3: mean of |v_{k+1}/v_k|, k = 0..4.
+    pub e: f64,
+    /// Eq. 4, e⁺: mean of √(v_3/v_1), √(v_5/v_3).
+    pub e_plus: f64,
+    /// Eq. 4, e⁻: mean of √(v_2/v_0), √(v_4/v_2).
+    pub e_minus: f64,
+    /// Eqs. 5–6: e / e_H, e⁺ / e_H, e⁻ / e_H.
+    pub r: f64,
+    pub r_plus: f64,
+    pub r_minus: f64,
+    /// Table 3: |v_1/v_0| / e_H.
+    pub r1: f64,
+    /// Table 3: √(v_3/v_1) / e_H.
+    pub r1_plus: f64,
+    /// Table 3: √(v_2/v_0) / e_H.
+    pub r1_minus: f64,
+    /// Table 2 "r (2 impacts)": mean of |v_1/v_0|, |v_2/v_1|, divided by e_H.
+    pub r2: f64,
+}
+
+/// Local ratio of Eq. 3: |v_{k+1}/v_k| for k = 0..n−2.
+pub fn local_ratios(v: &[f64]) -> Vec<f64> {
+    v.windows(2).map(|w| (w[1] / w[0]).abs()).collect()
+}
+
+/// √(v_{k+2}/v_k): the same-sign ratio of Eq. 4 (the ratio of two peaks of the same
+/// sign is positive; its absolute value is taken so that noise cannot flip it).
+pub fn same_sign_ratio(v: &[f64], k: usize) -> f64 {
+    (v[k + 2] / v[k]).abs().sqrt()
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// All quantities from the first six peaks; `None` with fewer than six.
+pub fn coefficients(v: &[f64], e_h: f64) -> Option<Coefficients> {
+    if v.len() < 6 {
+        return None;
+    }
+    let local = local_ratios(&v[..6]);
+    let e = mean(&local);
+    let e_minus = 0.5 * (same_sign_ratio(v, 0) + same_sign_ratio(v, 2));
+    let e_plus = 0.5 * (same_sign_ratio(v, 1) + same_sign_ratio(v, 3));
+    Some(Coefficients {
+        e,
+        e_plus,
+        e_minus,
+        r: e / e_h,
+        r_plus: e_plus / e_h,
+        r_minus: e_minus / e_h,
+        r1: local[0] / e_h,
+        r1_plus: same_sign_ratio(v, 1) / e_h,
+        r1_minus: same_sign_ratio(v, 0) / e_h,
+        r2: 0.5 * (local[0] + local[1]) / e_h,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hand_computed_sequence() {
+        // v = -100, 50, -40, 30, -20, 12 ; e_H = 0.9
+        let v = [-100.0, 50.0, -40.0, 30.0, -20.0, 12.0];
+        let c = coefficients(&v, 0.9).unwrap();
+        let e = (0.5 + 0.8 + 0.75 + 2.0 / 3.0 + 0.6) / 5.0;
+        assert!((c.e - e).abs() < 1e-12);
+        let em = (0.4f64.sqrt() + 0.5f64.sqrt()) / 2.0;
+        let ep = (0.6f64.sqrt() + 0.4f64.sqrt()) / 2.0;
+        assert!((c.e_minus - em).abs() < 1e-12);
+        assert!((c.e_plus - ep).abs() < 1e-12);
+        assert!((c.r - e / 0.9).abs() < 1e-12);
+        assert!((c.r_plus - ep / 0.9).abs() < 1e-12);
+        assert!((c.r_minus - em / 0.9).abs() < 1e-12);
+        assert!((c.r1 - 0.5 / 0.9).abs() < 1e-12);
+        assert!((c.r1_plus - 0.6f64.sqrt() / 0.9).abs() < 1e-12);
+        assert!((c.r1_minus - 0.4f64.sqrt() / 0.9).abs() < 1e-12);
+        assert!((c.r2 - 0.65 / 0.9).abs() < 1e-12);
+    }
+
+    #[test]
+    fn geometric_sequence_gives_its_ratio_everywhere() {
+        let v: Vec<f64> = (0..6).map(|k| 500.0 * (-0.8f64).powi(k)).collect();
+        let c = coefficients(&v, 1.0).unwrap();
+        for q in [c.e, c.e_plus, c.e_minus, c.r1, c.r1_plus, c.r1_minus, c.r2] {
+            assert!((q - 0.8).abs() < 1e-12, "{q}");
+        }
+    }
+
+    #[test]
+    fn fewer_than_six_peaks_is_none() {
+        assert!(coefficients(&[1.0, -1.0, 1.0, -1.0, 1.0], 1.0).is_none());
+    }
+}

@@ -179,8 +179,10 @@ pub fn analyse(
     // level 0 and removes a linear drift.
     detrend_by_final_rest(t, &mut x);
     let rest = 0.0;
-    let n_edge = (n / 10).max(5);
-    let hold = median(&x[..n_edge]);
+    // The log starts with the wall held at its imposed displacement: its first
+    // samples (25, or a tenth of a short log) give the hold level.
+    let n_hold = (n / 10).clamp(5, 25);
+    let hold = median(&x[..n_hold]);
     let amplitude = hold - rest;
     if amplitude.abs() < 20.0 * sigma {
         return Err(PeakError::NoRelease {

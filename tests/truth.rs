@@ -62,3 +62,63 @@ fn one_sided_demo_within_one_point() {
 fn two_sided_demo_within_one_point() {
     check("two-sided-demo");
 }
+
+/// The same test after what real acquisition does to a log: 100 Hz instead of 200,
+/// isolated spikes, a clock that does not start at zero, an extra drift. The truth
+/// is unchanged, so the same 1.0 pp bound applies (100 Hz halves the samples of the
+/// late half-cycles, which raises the noise floor; the bound still holds with a
+/// margin on 150_2, see the printed errors).
+#[test]
+fn robust_to_decimation_spikes_clock_offset_and_drift() {
+    use rocklab::peaks::analyse;
+    use rocklab::reduce::{physics, read_log};
+    use rocklab::restitution::coefficients;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/one-sided-demo");
+    let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    for id in ["150_2", "100_1"] {
+        let spec = campaign.tests.iter().find(|t| t.id == id).unwrap();
+        let log = read_log(spec).unwrap();
+        let tt = truth["tests"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|x| x["id"] == id)
+            .unwrap();
+        let variants: Vec<(&str, Vec<f64>, Vec<f64>)> = vec![
+            (
+                "100 Hz",
+                log.time_s.iter().step_by(2).copied().collect(),
+                log.disp_mm.iter().step_by(2).copied().collect(),
+            ),
+            ("spikes", log.time_s.clone(), {
+                let mut x = log.disp_mm.clone();
+                for (k, i) in [37usize, 400, 555, 901, 1500, 2200].iter().enumerate() {
+                    x[*i] += if k % 2 == 0 { 4.0 } else { -3.0 };
+                }
+                x
+            }),
+            (
+                "clock offset + drift",
+                log.time_s.iter().map(|t| t + 1234.5).collect(),
+                log.time_s
+                    .iter()
+                    .zip(&log.disp_mm)
+                    .map(|(t, x)| x + 0.02 * t)
+                    .collect(),
+            ),
+        ];
+        for (name, t, x) in variants {
+            let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default())
+                .unwrap_or_else(|e| panic!("{id} {name}: {e}"));
+            let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
+            let c = serde_json::to_value(coefficients(&v, campaign.e_housner).unwrap()).unwrap();
+            for k in KEYS {
+                let err = 100.0 * (c[k].as_f64().unwrap() - tt[k].as_f64().unwrap());
+                println!("{id} {name} {k} {err:+.2}");
+                assert!(err.abs() <= 1.0, "{id} {name}: {k} off by {err:.2} pp");
+            }
+        }
+    }
+}

@@ -150,7 +150,8 @@ impl LogReader {
                 message: "only '#' metadata lines: expected a header row and numeric rows".into(),
             });
         }
-        let header_line = rec.position().map_or(0, |p| p.line());
+        // The csv reader does not count skipped '#' lines in the header's position.
+        let header_line = header_line_number(bytes);
         let names: Vec<String> = rec
             .iter()
             .map(|f| String::from_utf8_lossy(f).trim().to_string())
@@ -300,6 +301,20 @@ impl LogReader {
         };
         Ok((delimiter, decimal))
     }
+}
+
+/// 1-based line number of the header: the first line that is neither blank nor a
+/// '#' metadata line.
+fn header_line_number(bytes: &[u8]) -> u64 {
+    let mut line = 1;
+    for l in bytes.split(|b| *b == b'\n') {
+        let l = l.strip_suffix(b"\r").unwrap_or(l);
+        if !l.iter().all(|b| b.is_ascii_whitespace()) && l[0] != b'#' {
+            return line;
+        }
+        line += 1;
+    }
+    line
 }
 
 fn short(e: &InputError) -> String {

@@ -1,0 +1,322 @@
+//! End-to-end tests of `rocklab reduce` and `rocklab demo` on the built binary, in
+//! a temporary folder (issue #2: defects, format invariance, one broken test never
+//! stops the others).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use serde_json::Value;
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns")
+}
+
+fn good_log() -> String {
+    std::fs::read_to_string(fixtures().join("one-sided-demo/150_2.csv")).unwrap()
+}
+
+const HEAD: &str = r#"[campaign]
+name = "t"
+rocking = "one-sided"
+[wall]
+height_m = 2.70
+thickness_m = 0.36
+hinge_height_m = 0.23
+[channels]
+time = { column = "time_s", unit = "s" }
+displacement = { column = "disp_mm", unit = "mm", height_m = 2.56 }
+outward_sign = 1
+"#;
+
+/// A campaign folder with the good log as test "good" plus the given extra tests
+/// (id, file name, file bytes or None for a missing file, extra TOML lines).
+fn campaign(extra: &[(&str, &str, Option<Vec<u8>>, &str)]) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("good.csv"), good_log()).unwrap();
+    let mut toml = format!("{HEAD}\n[[test]]\nid = \"good\"\nfile = \"good.csv\"\n");
+    for (id, file, bytes, lines) in extra {
+        if let Some(b) = bytes {
+            std::fs::write(dir.path().join(file), b).unwrap();
+        }
+        toml.push_str(&format!(
+            "\n[[test]]\nid = \"{id}\"\nfile = \"{file}\"\n{lines}\n"
+        ));
+    }
+    let manifest = dir.path().join("campaign.toml");
+    std::fs::write(&manifest, toml).unwrap();
+    (dir, manifest)
+}
+
+struct Run {
+    code: i32,
+    stderr: String,
+    summary: Value,
+}
+
+fn reduce(manifest: &Path, out: &Path, extra: &[&str]) -> Run {
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .arg("reduce")
+        .arg(manifest)
+        .arg("--out")
+        .arg(out)
+        .arg("--no-plots")
+        .args(extra)
+        .output()
+        .unwrap();
+    let summary = std::fs::read_to_string(out.join("summary.json"))
+        .map(|s| serde_json::from_str(&s).unwrap())
+        .unwrap_or(Value::Null);
+    Run {
+        code: o.status.code().unwrap_or(-1),
+        stderr: String::from_utf8_lossy(&o.stderr).into(),
+        summary,
+    }
+}
+
+fn test_entry<'a>(s: &'a Value, id: &str) -> &'a Value {
+    s["tests"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["id"] == id)
+        .unwrap()
+}
+
+/// The broken test is listed as an error whose message contains `expect`, the good
+/// one is still reduced, the exit code is non-zero and stderr names the failure.
+fn assert_defect(bytes: Option<Vec<u8>>, expect: &[&str]) {
+    let (dir, manifest) = campaign(&[("bad", "bad.csv", bytes, "")]);
+    let out = dir.path().join("out");
+    let run = reduce(&manifest, &out, &[]);
+    assert_eq!(run.code, 1, "stderr: {}", run.stderr);
+    let bad = test_entry(&run.summary, "bad");
+    assert_eq!(bad["status"], "error");
+    let msg = bad["error"].as_str().unwrap();
+    for e in expect {
+        assert!(msg.contains(e), "message {msg:?} lacks {e:?}");
+    }
+    assert!(run.stderr.contains("test bad:"), "stderr: {}", run.stderr);
+    assert_eq!(test_entry(&run.summary, "good")["status"], "ok");
+    // No temporary file is left behind.
+    for f in std::fs::read_dir(&out).unwrap() {
+        let name = f.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".tmp"), "leftover {name}");
+    }
+}
+
+fn lines_with(replace_line: usize, with: &str) -> Vec<u8> {
+    // Line numbers are 1-based file lines (4 metadata lines, header on line 5).
+    let mut lines: Vec<String> = good_log().lines().map(String::from).collect();
+    lines[replace_line - 1] = with.to_string();
+    (lines.join("\n") + "\n").into_bytes()
+}
+
+#[test]
+fn defect_empty_file() {
+    assert_defect(Some(Vec::new()), &["bad.csv", "empty"]);
+}
+
+#[test]
+fn defect_header_without_data() {
+    assert_defect(
+        Some(b"# m\ntime_s,disp_mm,acc_g\n".to_vec()),
+        &["bad.csv:2:", "header row without data"],
+    );
+}
+
+#[test]
+fn defect_non_numeric_cell() {
+    assert_defect(
+        Some(lines_with(9, "0.020,abc,0.0")),
+        &["bad.csv:9:2", "'abc' is not a number"],
+    );
+}
+
+#[test]
+fn defect_nan() {
+    assert_defect(
+        Some(lines_with(10, "0.025,NaN,0.0")),
+        &["bad.csv:10:2", "not a finite number"],
+    );
+}
+
+#[test]
+fn defect_duplicated_time() {
+    assert_defect(
+        Some(lines_with(8, "0.005,147.7,0.0")),
+        &["bad.csv:8:1", "duplicated", "strictly increasing"],
+    );
+}
+
+#[test]
+fn defect_decreasing_time() {
+    assert_defect(
+        Some(lines_with(8, "0.001,147.7,0.0")),
+        &["bad.csv:8:1", "decreasing"],
+    );
+}
+
+#[test]
+fn defect_missing_column() {
+    let text = good_log().replace("time_s,disp_mm,acc_g", "time_s,d1,acc_g");
+    assert_defect(
+        Some(text.into_bytes()),
+        &[
+            "bad.csv:5",
+            "column 'disp_mm' not found",
+            "columns: time_s, d1, acc_g",
+        ],
+    );
+}
+
+#[test]
+fn defect_missing_file() {
+    assert_defect(None, &["bad.csv", "not found"]);
+}
+
+#[test]
+fn defect_short_row_in_the_middle() {
+    assert_defect(
+        Some(lines_with(12, "0.035")),
+        &["bad.csv:12:2", "expected a value for column 'disp_mm'"],
+    );
+}
+
+#[test]
+fn truncated_last_line_is_dropped_with_a_warning() {
+    let mut text = good_log();
+    text.push_str("13.020,0.0"); // no line end, missing the third column is fine, but cut mid-number:
+    text.push_str("\n13.025");
+    let (dir, manifest) = campaign(&[("cut", "cut.csv", Some(text.into_bytes()), "")]);
+    let run = reduce(&manifest, &dir.path().join("out"), &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let cut = test_entry(&run.summary, "cut");
+    assert_eq!(cut["status"], "ok");
+    let w = cut["warnings"][0].as_str().unwrap();
+    assert!(
+        w.contains("truncated last line") && w.contains(":2610:"),
+        "{w}"
+    );
+    assert!(run.stderr.contains("truncated last line"));
+}
+
+#[test]
+fn too_few_peaks_is_reported_not_tabulated() {
+    // A log that never moves: hold only.
+    let mut s = String::from("time_s,disp_mm\n");
+    for i in 0..400 {
+        s.push_str(&format!(
+            "{:.3},{:.3}\n",
+            i as f64 * 0.005,
+            0.01 * ((i * 7919) % 5) as f64
+        ));
+    }
+    let (dir, manifest) = campaign(&[("still", "still.csv", Some(s.into_bytes()), "")]);
+    let run = reduce(&manifest, &dir.path().join("out"), &[]);
+    assert_eq!(run.code, 1);
+    let e = test_entry(&run.summary, "still");
+    assert_eq!(e["status"], "error");
+    assert!(
+        e["error"].as_str().unwrap().contains("no release found"),
+        "{}",
+        e["error"]
+    );
+    assert!(e.get("r").is_none(), "no table values for a failed test");
+}
+
+/// Format invariance: `;` with decimal comma, ms and m, and outward_sign = −1 with
+/// negated data give the same numbers. Tolerance 1e-6 on the ratios: the unit
+/// conversions change the inputs in the last bits (5 ms · 1e-3 ≠ 0.005 exactly), so
+/// the iterative fit lands a few ulps apart; anything systematic would be ≫ 1e-6.
+#[test]
+fn format_invariance() {
+    let text = good_log();
+    let mut euro = String::new();
+    let mut ms_m = String::new();
+    let mut neg = String::new();
+    for line in text.lines() {
+        if line.starts_with('#') {
+            continue;
+        }
+        if line.starts_with("time_s") {
+            euro.push_str("time_s;disp_mm;acc_g\r\n");
+            ms_m.push_str("t_ms,x_m,acc_g\n");
+            neg.push_str("time_s,disp_mm,acc_g\n");
+            continue;
+        }
+        let f: Vec<&str> = line.split(',').collect();
+        euro.push_str(&format!(
+            "{};{};{}\r\n",
+            f[0].replace('.', ","),
+            f[1].replace('.', ","),
+            f[2].replace('.', ",")
+        ));
+        let t: f64 = f[0].parse().unwrap();
+        let x: f64 = f[1].parse().unwrap();
+        ms_m.push_str(&format!("{},{},{}\n", t * 1e3, x / 1e3, f[2]));
+        neg.push_str(&format!("{},{},{}\n", f[0], -x, f[2]));
+    }
+    let (dir, manifest) = campaign(&[
+        ("euro", "euro.csv", Some(euro.into_bytes()), ""),
+        ("ms_m", "ms_m.csv", Some(ms_m.into_bytes()), "time = { column = \"t_ms\", unit = \"ms\" }\ndisplacement = { column = \"x_m\", unit = \"m\", height_m = 2.56 }"),
+        ("neg", "neg.csv", Some(neg.into_bytes()), "outward_sign = -1"),
+    ]);
+    let run = reduce(&manifest, &dir.path().join("out"), &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let good = test_entry(&run.summary, "good").clone();
+    for id in ["euro", "ms_m", "neg"] {
+        let t = test_entry(&run.summary, id);
+        for k in [
+            "e", "e_plus", "e_minus", "r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2",
+        ] {
+            let (a, b) = (good[k].as_f64().unwrap(), t[k].as_f64().unwrap());
+            assert!((a - b).abs() < 1e-6, "{id}.{k}: {b} vs {a}");
+        }
+        let (pa, pb) = (
+            &good["peaks"][0]["velocity_mm_s"],
+            &t["peaks"][0]["velocity_mm_s"],
+        );
+        assert!(
+            (pa.as_f64().unwrap() - pb.as_f64().unwrap()).abs() < 1e-3,
+            "{id}: v0 {pb} vs {pa}"
+        );
+    }
+}
+
+/// Regression for issue #2: `demo` writes tables and plots for both campaigns.
+#[test]
+fn demo_writes_tables_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .args(["demo", "--fixtures"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"))
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("| 150_1 |"), "{stdout}");
+    for c in ["one-sided-demo", "two-sided-demo"] {
+        let d = dir.path().join(c);
+        for f in [
+            "summary.json",
+            "table1.csv",
+            "table1.md",
+            "table2.csv",
+            "table3.md",
+            "tables.md",
+        ] {
+            assert!(d.join(f).is_file(), "{c}/{f}");
+        }
+        let s: Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap())
+                .unwrap();
+        let first = s["tests"][0]["id"].as_str().unwrap().to_string();
+        let png = std::fs::read(d.join("plots").join(format!("{first}_motion.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+        let svg =
+            std::fs::read_to_string(d.join("plots").join(format!("{first}_ratios.svg"))).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("mean r ="));
+    }
+}

@@ -17,6 +17,7 @@ pub mod reduce;
 pub mod report;
 pub mod restitution;
 pub mod signal;
+pub mod solver;
 pub mod tables;
 pub mod wall;
 

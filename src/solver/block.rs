@@ -1,0 +1,54 @@
+//! A rigid rocking block: geometry → R, α, m, I_0 and p² (with overrides).
+
+use crate::G;
+
+/// The block's dynamic properties.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Block {
+    /// Half-diagonal R (m): distance from a pivot to the centre of mass.
+    pub r_m: f64,
+    /// Slenderness α (rad).
+    pub alpha: f64,
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Polar moment of inertia about a pivot, I_0 (kg m²).
+    pub i0: f64,
+}
+
+impl Block {
+    /// Rectangular block of height h, thickness b, width w and unit weight γ
+    /// (kN/m³): R = ½√(h² + b²), α = atan(b/h), m = γ h b w / g, I_0 = 4/3 m R².
+    pub fn rectangular(
+        height_m: f64,
+        thickness_m: f64,
+        width_m: f64,
+        unit_weight_kn_m3: f64,
+    ) -> Block {
+        let r = 0.5 * height_m.hypot(thickness_m);
+        let mass = unit_weight_kn_m3 * 1e3 * height_m * thickness_m * width_m / G;
+        Block {
+            r_m: r,
+            alpha: (thickness_m / height_m).atan(),
+            mass_kg: mass,
+            i0: 4.0 / 3.0 * mass * r * r,
+        }
+    }
+
+    /// p² = m g R / I_0 (s⁻²); 3g/(4R) for a rectangular block.
+    pub fn p2(&self) -> f64 {
+        self.mass_kg * G * self.r_m / self.i0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rectangular_p2_is_3g_over_4r() {
+        let b = Block::rectangular(7.64, 0.80, 12.0, 18.0);
+        assert!((b.p2() - 3.0 * G / (4.0 * b.r_m)).abs() < 1e-12);
+        assert!((b.r_m - 3.8409).abs() < 1e-4);
+        assert!((b.alpha - 0.10437).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,293 @@
+//! Issue #3: the rocking solver against analytic answers. Each test states its
+//! tolerance and why.
+
+use rocklab::solver::{simulate, Event, Ground, Restraint, RockingModel, Settings, Stop};
+use rocklab::G;
+
+const ALPHA: f64 = 0.2;
+const P2: f64 = 4.0;
+
+fn model(e_in: f64, e_out: f64, linearized: bool) -> RockingModel {
+    RockingModel {
+        alpha: ALPHA,
+        p2: P2,
+        i0: 1.0,
+        restraint: Restraint::None,
+        ties: Vec::new(),
+        e_in,
+        e_out,
+        overturn_limit: ALPHA,
+        linearized,
+    }
+}
+
+fn quiet() -> Ground {
+    Ground {
+        t0: 0.0,
+        dt: 1.0,
+        acc: vec![0.0; 2],
+    }
+}
+
+fn impacts(ev: &[Event]) -> Vec<(f64, i8, f64, f64)> {
+    ev.iter()
+        .filter_map(|e| match *e {
+            Event::Impact {
+                t,
+                entering,
+                v_before,
+                v_after,
+            } => Some((t, entering, v_before, v_after)),
+            _ => None,
+        })
+        .collect()
+}
+
+fn tight(t_end: f64) -> Settings {
+    Settings::new(t_end).with_tolerances(1e-12, 1e-14)
+}
+
+/// Linearised free rocking (e = 1): impacts at T/4 + k T/2 with
+/// T = (4/p) arccosh(1/(1 − θ₀/α)). Tolerance 1e-8 relative (the issue's): the
+/// integrator runs at rtol 1e-12 and events are located to 1e-13 s.
+#[test]
+fn linearized_period() {
+    let m = model(1.0, 1.0, true);
+    let theta0 = 0.5 * ALPHA;
+    let p = P2.sqrt();
+    let period = 4.0 / p * (1.0 / (1.0 - theta0 / ALPHA)).acosh();
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(5.0 * period));
+    let imp = impacts(&sim.events);
+    assert!(imp.len() >= 9, "{} impacts", imp.len());
+    for (k, (t, ..)) in imp.iter().enumerate() {
+        let expected = period / 4.0 + k as f64 * period / 2.0;
+        assert!(
+            (t / expected - 1.0).abs() < 1e-8,
+            "impact {k}: {t} vs {expected}"
+        );
+    }
+}
+
+/// Quarter period of the nonlinear equation by quadrature of the energy integral,
+/// T/4 = ∫₀^θ₀ dθ / √(2p² [cos(α − θ₀) − cos(α − θ)]), with θ = θ₀(1 − v²) to remove
+/// the end singularity, composite Gauss–Legendre (converged to < 1e-12).
+fn quarter_period_quadrature(theta0: f64) -> f64 {
+    let f = |v: f64| {
+        let th = theta0 * (1.0 - v * v);
+        let den = (2.0 * P2 * ((ALPHA - theta0).cos() - (ALPHA - th).cos())).sqrt();
+        if v == 0.0 {
+            // Limit v → 0: 2θ₀ v / √(2p² sin(α − θ₀) θ₀ v²)
+            2.0 * theta0 / (2.0 * P2 * (ALPHA - theta0).sin() * theta0).sqrt()
+        } else {
+            2.0 * theta0 * v / den
+        }
+    };
+    let (x, w) = (
+        [
+            -0.906179845938664,
+            -0.5384693101056831,
+            0.0,
+            0.5384693101056831,
+            0.906179845938664,
+        ],
+        [
+            0.23692688505618908,
+            0.47862867049936647,
+            0.5688888888888889,
+            0.47862867049936647,
+            0.23692688505618908,
+        ],
+    );
+    let n = 2000;
+    let mut s = 0.0;
+    for i in 0..n {
+        let (a, b) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+        for j in 0..5 {
+            s += 0.5 * (b - a) * w[j] * f(0.5 * (a + b) + 0.5 * (b - a) * x[j]);
+        }
+    }
+    s
+}
+
+/// Nonlinear period against quadrature (tolerance 1e-8 relative: quadrature
+/// converged well below, solver at rtol 1e-12); energy between impacts conserved
+/// to 1e-9 relative (the issue's bound; e = 1 so also across impacts).
+#[test]
+fn nonlinear_period_and_energy() {
+    let m = model(1.0, 1.0, false);
+    let theta0 = 0.6 * ALPHA;
+    let q = quarter_period_quadrature(theta0);
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(9.0 * q));
+    let imp = impacts(&sim.events);
+    assert!(imp.len() >= 4);
+    for (k, (t, ..)) in imp.iter().enumerate() {
+        let expected = q * (1 + 2 * k) as f64;
+        assert!(
+            (t / expected - 1.0).abs() < 1e-8,
+            "impact {k}: {t} vs {expected}"
+        );
+    }
+    let e0 = m.energy(theta0, 0.0);
+    for s in &sim.history {
+        let e = m.energy(s.theta, s.omega);
+        assert!(
+            (e / e0 - 1.0).abs() < 1e-9,
+            "energy drift at t = {}: {}",
+            s.t,
+            e / e0 - 1.0
+        );
+    }
+}
+
+/// Each impact multiplies θ' by exactly e_in or e_out according to the side
+/// entered, and the amplitudes obey cos(α − θₙ₊₁) − cos α = e² [cos(α − θₙ) − cos α]
+/// (energy: the speed at θ = 0 is √(2p²(cos(α − θₙ) − cos α))). Tolerance 1e-9
+/// relative on the amplitude relation (extrema located on the dense output).
+#[test]
+fn impacts_and_amplitudes() {
+    let (e_in, e_out) = (0.8, 0.9);
+    let m = model(e_in, e_out, false);
+    let theta0 = 0.7 * ALPHA;
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(6.0));
+    let imp = impacts(&sim.events);
+    assert!(imp.len() >= 6);
+    for (k, &(_, entering, vb, va)) in imp.iter().enumerate() {
+        let expected_entering = if k % 2 == 0 { -1 } else { 1 };
+        assert_eq!(entering, expected_entering, "impact {k}");
+        let e = if entering < 0 { e_in } else { e_out };
+        assert_eq!(va, e * vb, "impact {k}: exactly e times");
+    }
+    // Amplitude after impact k from the speed after it (energy on the new side).
+    let mut amp = theta0;
+    for &(_, entering, _, va) in imp.iter().take(5) {
+        let e = if entering < 0 { e_in } else { e_out };
+        let lhs_next = 0.5 * va * va / P2; // = cos(α − θₙ₊₁) − cos α
+        let rhs = e * e * ((ALPHA - amp).cos() - ALPHA.cos());
+        assert!((lhs_next / rhs - 1.0).abs() < 1e-9, "{lhs_next} vs {rhs}");
+        amp = ALPHA - (lhs_next + ALPHA.cos()).acos();
+    }
+    // And the extremes tracked by the solver agree with the first amplitudes.
+    let first_inward = {
+        let (_, _, _, va) = imp[0];
+        let c = 0.5 * va * va / P2 + ALPHA.cos();
+        -(ALPHA - c.acos())
+    };
+    assert!(
+        (sim.min_theta / first_inward - 1.0).abs() < 1e-8,
+        "{} vs {first_inward}",
+        sim.min_theta
+    );
+}
+
+/// Constant ground acceleration 0.1 % below g tan α: no motion; 0.1 % above:
+/// uplift at once towards the sign of ü_g.
+#[test]
+fn uplift_threshold() {
+    let m = model(0.9, 0.9, false);
+    let thr = G * ALPHA.tan();
+    for (a, moves) in [
+        (0.999 * thr, false),
+        (1.001 * thr, true),
+        (-0.999 * thr, false),
+        (-1.001 * thr, true),
+    ] {
+        let g = Ground {
+            t0: 0.0,
+            dt: 0.5,
+            acc: vec![a; 5],
+        };
+        let sim = simulate(&m, &g, 0.0, None, &Settings::new(2.0));
+        let up = sim.events.iter().find_map(|e| match e {
+            Event::Uplift { t, side } => Some((*t, *side)),
+            _ => None,
+        });
+        assert_eq!(up.is_some(), moves, "a = {a}");
+        if let Some((t, side)) = up {
+            assert!(t < 1e-9);
+            assert_eq!(side as f64, a.signum());
+            assert!(sim.max_theta.abs().max(sim.min_theta.abs()) > 0.0);
+            assert_eq!(sim.max_theta > 0.0, a > 0.0);
+        } else {
+            assert_eq!((sim.max_theta, sim.min_theta), (0.0, 0.0));
+        }
+    }
+}
+
+/// Under a sine pulse a_p sin(ω_p t) the block uplifts at arcsin(g tan α / a_p)/ω_p.
+/// Tolerance 1e-8 s: the record is sampled every 1e-4 s and the uplift is exact on
+/// its linear interpolation, whose error in time is ~ dt² ω_p tan(ω_p t)/8 ≈ 1e-9 s.
+#[test]
+fn uplift_time_under_a_sine_pulse() {
+    let m = model(0.9, 0.9, false);
+    let (ap, wp) = (2.0 * G * ALPHA.tan(), 2.0 * std::f64::consts::PI / 0.5);
+    let dt = 1e-4;
+    let acc: Vec<f64> = (0..=5000)
+        .map(|i| ap * (wp * i as f64 * dt).sin())
+        .collect();
+    let g = Ground { t0: 0.0, dt, acc };
+    let sim = simulate(&m, &g, 0.0, None, &Settings::new(0.3));
+    let t_up = sim.events.iter().find_map(|e| match e {
+        Event::Uplift { t, .. } => Some(*t),
+        _ => None,
+    });
+    let expected = (G * ALPHA.tan() / ap).asin() / wp;
+    let t_up = t_up.expect("uplift");
+    assert!((t_up - expected).abs() < 1e-8, "{t_up} vs {expected}");
+}
+
+/// Rectangular pulse of duration t_d: the linearised block overturns when
+/// a_p/(g α) ≥ 1/(1 − e^(−p t_d)) (Housner 1963). Exact for the linearised
+/// equation, so the margins are 0.2 % either side; the pulse is sampled every
+/// t_d/20000, whose ramp shifts the threshold by ~2.5e-5 relative. With the full
+/// nonlinear equation and α = 0.2 the small-angle closed form is off by O(α²/6)
+/// ≈ 1 %: there we only check that 5 % above overturns and 5 % below does not.
+#[test]
+fn rectangular_pulse_overturning() {
+    let td = 0.3;
+    let p = P2.sqrt();
+    let crit = 1.0 / (1.0 - (-p * td).exp());
+    let run = |factor: f64, linearized: bool| {
+        let m = model(0.9, 0.9, linearized);
+        // For the linearised model the forcing term is (p²/g) a: a = k g α.
+        let a = factor * crit * G * ALPHA;
+        let n = 20000;
+        let dt = td / n as f64;
+        let mut acc = vec![a; n + 1];
+        acc.extend(std::iter::repeat_n(0.0, 10));
+        let g = Ground { t0: 0.0, dt, acc };
+        simulate(
+            &m,
+            &g,
+            0.0,
+            None,
+            &Settings::new(td + 15.0).without_history(),
+        )
+        .stop
+    };
+    assert!(matches!(run(1.002, true), Stop::Overturned { .. }));
+    assert_eq!(run(0.998, true), Stop::End);
+    assert!(matches!(run(1.05, false), Stop::Overturned { .. }));
+    assert_eq!(run(0.95, false), Stop::End);
+}
+
+/// One-sided restraint: with a stiff inward spring the block never overturns
+/// inward and bounces back; chattering ends in rest (no endless loop).
+#[test]
+fn one_sided_free_rocking_ends_at_rest() {
+    let mut m = model(0.6, 0.7, false);
+    m.restraint = Restraint::Rotational { k_nm_per_rad: 60.0 };
+    let sim = simulate(
+        &m,
+        &quiet(),
+        0.0,
+        Some([0.5 * ALPHA, 0.0]),
+        &Settings::new(60.0),
+    );
+    assert!(
+        sim.events.iter().any(|e| matches!(e, Event::Rest { .. })),
+        "never came to rest"
+    );
+    assert_eq!(sim.stop, Stop::End);
+    assert!(sim.min_theta > -0.05 && sim.min_theta < 0.0);
+    assert!(sim.steps < 200_000, "{} steps", sim.steps);
+}

@@ -14,9 +14,7 @@ pub enum InputError {
     },
     #[error("{file}: file not found (expected a log exported by the data-acquisition system)")]
     Missing { file: PathBuf },
-    #[error(
-        "{file}: the file is empty (expected '#' metadata lines, a header row and numeric rows)"
-    )]
+    #[error("{file}: the file is empty (expected '#' metadata lines, a header row and numeric rows)")]
     Empty { file: PathBuf },
     #[error("{file}:{line}: header row without data (expected numeric rows after the header)")]
     NoData { file: PathBuf, line: u64 },
@@ -28,11 +26,7 @@ pub enum InputError {
         message: String,
     },
     #[error("{file}:{line}: {message}")]
-    Line {
-        file: PathBuf,
-        line: u64,
-        message: String,
-    },
+    Line { file: PathBuf, line: u64, message: String },
     #[error("{file}: {message}")]
     File { file: PathBuf, message: String },
 }

@@ -19,6 +19,7 @@ pub mod report;
 pub mod restitution;
 pub mod signal;
 pub mod solver;
+pub mod study;
 pub mod tables;
 pub mod wall;
 

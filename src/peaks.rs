@@ -99,7 +99,9 @@ pub enum PeakError {
     TooShort(usize),
     #[error("no release found: the displacement stays within {amplitude_mm:.3} mm of its final rest level (noise {noise_mm:.3} mm)")]
     NoRelease { amplitude_mm: f64, noise_mm: f64 },
-    #[error("the log starts {0:.2} mm on the inward side of its final rest level: expected a release from an outward displacement (check outward_sign)")]
+    #[error(
+        "the log starts {0:.2} mm on the inward side of its final rest level: expected a release from an outward displacement (check outward_sign)"
+    )]
     InwardStart(f64),
     #[error("too few peaks (n = {found} < {needed}): the rocking after release shows only {found} reliable half-cycles above the noise")]
     TooFewPeaks { found: usize, needed: usize },
@@ -159,12 +161,7 @@ pub struct Analysis {
 }
 
 /// Analyse one log: `t` in s (strictly increasing), `x` in mm outward positive.
-pub fn analyse(
-    t: &[f64],
-    x: &[f64],
-    phys: &Physics,
-    opts: &PeakOptions,
-) -> Result<Analysis, PeakError> {
+pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
     let n = t.len();
     if n < 20 {
         return Err(PeakError::TooShort(n));
@@ -193,12 +190,10 @@ pub fn analyse(
     if amplitude < 0.0 {
         return Err(PeakError::InwardStart(-amplitude));
     }
-    let departure = find_departure(&x, hold, (6.0 * sigma).max(0.01 * amplitude)).ok_or(
-        PeakError::NoRelease {
-            amplitude_mm: amplitude,
-            noise_mm: sigma,
-        },
-    )?;
+    let departure = find_departure(&x, hold, (6.0 * sigma).max(0.01 * amplitude)).ok_or(PeakError::NoRelease {
+        amplitude_mm: amplitude,
+        noise_mm: sigma,
+    })?;
     let crossings = find_crossings(t, &x, rest, sigma, departure, opts.n_peaks + 1);
     if crossings.len() < opts.n_peaks {
         return Err(PeakError::TooFewPeaks {
@@ -211,14 +206,7 @@ pub fn analyse(
     match opts.method {
         Method::SavGol(filter) => {
             let v = filter.derivative(&x, dt);
-            let (peaks, impacts) = pick_peaks(
-                t,
-                &v,
-                &crossings,
-                departure,
-                filter.window() / 2,
-                opts.n_peaks,
-            );
+            let (peaks, impacts) = pick_peaks(t, &v, &crossings, departure, filter.window() / 2, opts.n_peaks);
             let release = t[departure.saturating_sub(1)];
             Ok(Analysis {
                 release_time_s: release,
@@ -235,16 +223,7 @@ pub fn analyse(
             })
         }
         Method::Segments => {
-            let fit = SegmentFit::run(
-                t,
-                &x,
-                rest,
-                sigma,
-                departure,
-                &crossings,
-                phys,
-                opts.n_peaks,
-            )?;
+            let fit = SegmentFit::run(t, &x, rest, sigma, departure, &crossings, phys, opts.n_peaks)?;
             fit.fill_velocity(t, &mut velocity);
             let impacts = fit.impacts();
             let peaks = impacts
@@ -286,12 +265,7 @@ fn remove_isolated_spikes(x: &mut [f64], threshold: f64) -> usize {
         let c = d2(i, x);
         let l = d2(i - 1, x);
         let r = d2(i + 1, x);
-        if c.abs() > threshold
-            && l * c < 0.0
-            && r * c < 0.0
-            && l.abs() > c.abs() / 4.0
-            && r.abs() > c.abs() / 4.0
-        {
+        if c.abs() > threshold && l * c < 0.0 && r * c < 0.0 && l.abs() > c.abs() / 4.0 && r.abs() > c.abs() / 4.0 {
             x[i] = 0.5 * (x[i - 1] + x[i + 1]);
             count += 1;
         }
@@ -325,14 +299,7 @@ fn find_departure(x: &[f64], hold: f64, threshold: f64) -> Option<usize> {
 /// crossing time is the linear interpolation of the last sign change before the
 /// confirmation. A last side that never confirms its end gets the first sign change
 /// after its extreme (the late half-cycles of one-sided rocking are tiny).
-fn find_crossings(
-    t: &[f64],
-    x: &[f64],
-    rest: f64,
-    sigma: f64,
-    start: usize,
-    max: usize,
-) -> Vec<f64> {
+fn find_crossings(t: &[f64], x: &[f64], rest: f64, sigma: f64, start: usize, max: usize) -> Vec<f64> {
     let y = |i: usize| x[i] - rest;
     let n = x.len();
     let mut out = Vec::new();
@@ -380,9 +347,7 @@ fn find_crossings(
             }
         }
         if side * y(ext) > 2.0 * sigma {
-            if let Some(j) =
-                (ext..stop.saturating_sub(1)).find(|&k| side * y(k) > 0.0 && side * y(k + 1) <= 0.0)
-            {
+            if let Some(j) = (ext..stop.saturating_sub(1)).find(|&k| side * y(k) > 0.0 && side * y(k + 1) <= 0.0) {
                 let (ya, yb) = (y(j), y(j + 1));
                 out.push(t[j] + (t[j + 1] - t[j]) * ya / (ya - yb));
             }
@@ -394,14 +359,7 @@ fn find_crossings(
 /// Peak picking on a smoothed derivative: v_k is the extreme of the half-cycle that
 /// ends at crossing k (searched up to `half` samples past the crossing, since the
 /// smoothed peak is displaced by the window).
-fn pick_peaks(
-    t: &[f64],
-    v: &[f64],
-    crossings: &[f64],
-    start: usize,
-    half: usize,
-    n_peaks: usize,
-) -> (Vec<Peak>, Vec<Impact>) {
+fn pick_peaks(t: &[f64], v: &[f64], crossings: &[f64], start: usize, half: usize, n_peaks: usize) -> (Vec<Peak>, Vec<Impact>) {
     let idx = |tc: f64| t.partition_point(|&s| s < tc);
     let mut peaks = Vec::new();
     let mut impacts = Vec::new();
@@ -422,11 +380,7 @@ fn pick_peaks(
         impacts.push(Impact {
             k,
             time_s: tc,
-            entering: if k % 2 == 0 {
-                Side::Inward
-            } else {
-                Side::Outward
-            },
+            entering: if k % 2 == 0 { Side::Inward } else { Side::Outward },
             v_before_mm_s: v[best],
             v_after_mm_s: None,
         });
@@ -495,18 +449,10 @@ impl Model {
     ///   L θ = C (1 − cos(ω (t − t_m)) / cos(ω T/2)).
     fn segment(&self, s: usize, t: f64) -> (f64, f64) {
         if s == 0 {
-            let (a0, p0, tr, t0) = (
-                self.q[IA0].exp(),
-                self.q[IP0].exp(),
-                self.q[ITR],
-                self.q[IT0],
-            );
+            let (a0, p0, tr, t0) = (self.q[IA0].exp(), self.q[IP0].exp(), self.q[ITR], self.q[IT0]);
             let c = (p0 * (t0 - tr)).cosh();
             let tau = (t - tr).max(0.0);
-            return (
-                a0 * (1.0 - (p0 * tau).cosh() / c),
-                -a0 * p0 * (p0 * tau).sinh() / c,
-            );
+            return (a0 * (1.0 - (p0 * tau).cosh() / c), -a0 * p0 * (p0 * tau).sinh() / c);
         }
         let (ta, tb) = (self.impact(s - 1), self.impact(s));
         let (tm, half) = (0.5 * (ta + tb), 0.5 * (tb - ta));
@@ -522,17 +468,11 @@ impl Model {
             let w = l.sqrt();
             let c = a * p * p / l;
             let den = (w * half).cos();
-            (
-                c * (1.0 - (w * tau).cos() / den),
-                c * w * (w * tau).sin() / den,
-            )
+            (c * (1.0 - (w * tau).cos() / den), c * w * (w * tau).sin() / den)
         } else {
             let sign = if inward { -1.0 } else { 1.0 };
             let den = (p * half).cosh();
-            (
-                sign * a * (1.0 - (p * tau).cosh() / den),
-                -sign * a * p * (p * tau).sinh() / den,
-            )
+            (sign * a * (1.0 - (p * tau).cosh() / den), -sign * a * p * (p * tau).sinh() / den)
         }
     }
 
@@ -577,12 +517,7 @@ impl Model {
 
 /// Levenberg–Marquardt on a [`Model`] with a forward-difference Jacobian. Returns
 /// the fitted model and its residual sum of squares.
-fn levenberg_marquardt(
-    mut model: Model,
-    t: &[f64],
-    y: &[f64],
-    max_iter: usize,
-) -> Option<(Model, f64)> {
+fn levenberg_marquardt(mut model: Model, t: &[f64], y: &[f64], max_iter: usize) -> Option<(Model, f64)> {
     let n = t.len();
     let free: Vec<usize> = (0..model.q.len())
         .filter(|&j| j != IP && j != ID && (j != IL || model.one_sided))
@@ -599,11 +534,7 @@ fn levenberg_marquardt(
         // Jacobian of the residuals.
         let mut jac = DMatrix::zeros(n, np);
         for (j, &pj) in free.iter().enumerate() {
-            let h = if pj >= ITR {
-                1e-6
-            } else {
-                1e-7 * model.q[pj].abs().max(1e-3)
-            };
+            let h = if pj >= ITR { 1e-6 } else { 1e-7 * model.q[pj].abs().max(1e-3) };
             let mut m2 = model.clone();
             m2.q[pj] += h;
             if !m2.residuals(t, y, &mut rp) {
@@ -700,10 +631,7 @@ impl SegmentFit {
             .map(|&v| rest + lever * ((v - rest) / lever).clamp(-1.0, 1.0).asin())
             .collect();
         if tw.len() < 3 * m + 8 {
-            return Err(PeakError::Fit(format!(
-                "only {} samples in the rocking window",
-                tw.len()
-            )));
+            return Err(PeakError::Fit(format!("only {} samples in the rocking window", tw.len())));
         }
         // Starting values from the geometry and the crossings.
         let hold = median(&yw[..(t.partition_point(|&v| v < t_dep) - i0).max(1)]) - rest;
@@ -712,27 +640,10 @@ impl SegmentFit {
         let h0 = hold.max(1e-3);
         let a0 = a.max(1.5 * h0);
         let tr = t0 - ((a0 / (a0 - h0)).acosh() / p).min(t0 - start_t - dt);
-        let mut q = vec![
-            rest,
-            0.0,
-            a.ln(),
-            p.ln(),
-            (10.0 * p * p).ln(),
-            a0.ln(),
-            p.ln(),
-            tr,
-        ];
+        let mut q = vec![rest, 0.0, a.ln(), p.ln(), (10.0 * p * p).ln(), a0.ln(), p.ln(), tr];
         q.extend_from_slice(&crossings[..m]);
-        let base = Model {
-            one_sided,
-            t_ref: t0,
-            q,
-        };
-        let starts: Vec<f64> = if one_sided {
-            vec![3.0, 8.0, 15.0, 30.0, 60.0]
-        } else {
-            vec![1.0]
-        };
+        let base = Model { one_sided, t_ref: t0, q };
+        let starts: Vec<f64> = if one_sided { vec![3.0, 8.0, 15.0, 30.0, 60.0] } else { vec![1.0] };
         let mut best: Option<(Model, f64)> = None;
         for s in starts {
             let mut mdl = base.clone();
@@ -740,10 +651,7 @@ impl SegmentFit {
             // Keep the inward arcs below a quarter period at the start.
             if one_sided {
                 let w = (s * p * p).sqrt();
-                let longest = (1..m)
-                    .step_by(2)
-                    .map(|k| crossings[k] - crossings[k - 1])
-                    .fold(0.0, f64::max);
+                let longest = (1..m).step_by(2).map(|k| crossings[k] - crossings[k - 1]).fold(0.0, f64::max);
                 if w * 0.5 * longest >= 1.5 {
                     continue;
                 }
@@ -754,8 +662,7 @@ impl SegmentFit {
                 }
             }
         }
-        let (model, cost) =
-            best.ok_or_else(|| PeakError::Fit("no starting point gave a valid model".into()))?;
+        let (model, cost) = best.ok_or_else(|| PeakError::Fit("no starting point gave a valid model".into()))?;
         Ok(SegmentFit {
             model,
             rms: (cost / tw.len() as f64).sqrt(),
@@ -783,11 +690,7 @@ impl SegmentFit {
                 Impact {
                     k,
                     time_s: self.model.impact(k),
-                    entering: if k % 2 == 0 {
-                        Side::Inward
-                    } else {
-                        Side::Outward
-                    },
+                    entering: if k % 2 == 0 { Side::Inward } else { Side::Outward },
                     v_before_mm_s: before,
                     v_after_mm_s: after,
                 }

@@ -38,12 +38,9 @@ pub struct CampaignResult {
 
 impl CampaignResult {
     pub fn failed(&self) -> impl Iterator<Item = (&str, &str)> {
-        self.tests.iter().filter_map(|t| {
-            t.result
-                .as_ref()
-                .err()
-                .map(|e| (t.spec.id.as_str(), e.as_str()))
-        })
+        self.tests
+            .iter()
+            .filter_map(|t| t.result.as_ref().err().map(|e| (t.spec.id.as_str(), e.as_str())))
     }
 }
 
@@ -61,10 +58,7 @@ pub fn read_log(spec: &TestSpec) -> Result<LogData, String> {
     LogReader::new(&spec.file)
         .format(spec.format)
         .time(&spec.time.column, spec.time.unit.to_s())
-        .displacement(
-            &spec.displacement.column,
-            spec.displacement.unit.to_mm() * spec.outward_sign,
-        )
+        .displacement(&spec.displacement.column, spec.displacement.unit.to_mm() * spec.outward_sign)
         .read()
         .map_err(|e| e.to_string())
 }
@@ -87,8 +81,7 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
         .map_err(|e| format!("{file}: {e}"))
         .and_then(|analysis| {
             let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
-            let c = coefficients(&v, campaign.e_housner)
-                .ok_or_else(|| format!("{file}: too few peaks (n = {} < 6)", v.len()))?;
+            let c = coefficients(&v, campaign.e_housner).ok_or_else(|| format!("{file}: too few peaks (n = {} < 6)", v.len()))?;
             Ok(Reduced {
                 log,
                 analysis,
@@ -104,11 +97,7 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 
 /// Reduce every test of a campaign (in parallel) and compute the means.
 pub fn reduce_campaign(campaign: Campaign, options: PeakOptions) -> CampaignResult {
-    let tests: Vec<TestOutcome> = campaign
-        .tests
-        .par_iter()
-        .map(|s| reduce_test(&campaign, s, &options))
-        .collect();
+    let tests: Vec<TestOutcome> = campaign.tests.par_iter().map(|s| reduce_test(&campaign, s, &options)).collect();
     let rows: Vec<Row> = tests
         .iter()
         .map(|t| Row {

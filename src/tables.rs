@@ -58,11 +58,7 @@ pub fn campaign_means(rows: &[Row]) -> CampaignMeans {
             r2: m(|c| c.r2),
         }
     });
-    CampaignMeans {
-        means,
-        included,
-        left_out,
-    }
+    CampaignMeans { means, included, left_out }
 }
 
 #[cfg(test)]
@@ -103,10 +99,7 @@ mod tests {
         let means = m.means.unwrap();
         assert_eq!(format!("{:.2}", means.r_minus), "0.59");
         assert_eq!(format!("{:.2}", means.r_plus), "0.68");
-        assert_eq!(
-            m.left_out,
-            vec![("50_1".to_string(), "exclude_from_mean".to_string())]
-        );
+        assert_eq!(m.left_out, vec![("50_1".to_string(), "exclude_from_mean".to_string())]);
         assert_eq!(m.included.len(), 4);
     }
 }

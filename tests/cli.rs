@@ -38,9 +38,7 @@ fn campaign(extra: &[(&str, &str, Option<Vec<u8>>, &str)]) -> (tempfile::TempDir
         if let Some(b) = bytes {
             std::fs::write(dir.path().join(file), b).unwrap();
         }
-        toml.push_str(&format!(
-            "\n[[test]]\nid = \"{id}\"\nfile = \"{file}\"\n{lines}\n"
-        ));
+        toml.push_str(&format!("\n[[test]]\nid = \"{id}\"\nfile = \"{file}\"\n{lines}\n"));
     }
     let manifest = dir.path().join("campaign.toml");
     std::fs::write(&manifest, toml).unwrap();
@@ -74,12 +72,7 @@ fn reduce(manifest: &Path, out: &Path, extra: &[&str]) -> Run {
 }
 
 fn test_entry<'a>(s: &'a Value, id: &str) -> &'a Value {
-    s["tests"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|t| t["id"] == id)
-        .unwrap()
+    s["tests"].as_array().unwrap().iter().find(|t| t["id"] == id).unwrap()
 }
 
 /// The broken test is listed as an error whose message contains `expect`, the good
@@ -118,26 +111,17 @@ fn defect_empty_file() {
 
 #[test]
 fn defect_header_without_data() {
-    assert_defect(
-        Some(b"# m\ntime_s,disp_mm,acc_g\n".to_vec()),
-        &["bad.csv:2:", "header row without data"],
-    );
+    assert_defect(Some(b"# m\ntime_s,disp_mm,acc_g\n".to_vec()), &["bad.csv:2:", "header row without data"]);
 }
 
 #[test]
 fn defect_non_numeric_cell() {
-    assert_defect(
-        Some(lines_with(9, "0.020,abc,0.0")),
-        &["bad.csv:9:2", "'abc' is not a number"],
-    );
+    assert_defect(Some(lines_with(9, "0.020,abc,0.0")), &["bad.csv:9:2", "'abc' is not a number"]);
 }
 
 #[test]
 fn defect_nan() {
-    assert_defect(
-        Some(lines_with(10, "0.025,NaN,0.0")),
-        &["bad.csv:10:2", "not a finite number"],
-    );
+    assert_defect(Some(lines_with(10, "0.025,NaN,0.0")), &["bad.csv:10:2", "not a finite number"]);
 }
 
 #[test]
@@ -150,10 +134,7 @@ fn defect_duplicated_time() {
 
 #[test]
 fn defect_decreasing_time() {
-    assert_defect(
-        Some(lines_with(8, "0.001,147.7,0.0")),
-        &["bad.csv:8:1", "decreasing"],
-    );
+    assert_defect(Some(lines_with(8, "0.001,147.7,0.0")), &["bad.csv:8:1", "decreasing"]);
 }
 
 #[test]
@@ -161,11 +142,7 @@ fn defect_missing_column() {
     let text = good_log().replace("time_s,disp_mm,acc_g", "time_s,d1,acc_g");
     assert_defect(
         Some(text.into_bytes()),
-        &[
-            "bad.csv:5",
-            "column 'disp_mm' not found",
-            "columns: time_s, d1, acc_g",
-        ],
+        &["bad.csv:5", "column 'disp_mm' not found", "columns: time_s, d1, acc_g"],
     );
 }
 
@@ -176,10 +153,7 @@ fn defect_missing_file() {
 
 #[test]
 fn defect_short_row_in_the_middle() {
-    assert_defect(
-        Some(lines_with(12, "0.035")),
-        &["bad.csv:12:2", "expected a value for column 'disp_mm'"],
-    );
+    assert_defect(Some(lines_with(12, "0.035")), &["bad.csv:12:2", "expected a value for column 'disp_mm'"]);
 }
 
 #[test]
@@ -193,10 +167,7 @@ fn truncated_last_line_is_dropped_with_a_warning() {
     let cut = test_entry(&run.summary, "cut");
     assert_eq!(cut["status"], "ok");
     let w = cut["warnings"][0].as_str().unwrap();
-    assert!(
-        w.contains("truncated last line") && w.contains(":2610:"),
-        "{w}"
-    );
+    assert!(w.contains("truncated last line") && w.contains(":2610:"), "{w}");
     assert!(run.stderr.contains("truncated last line"));
 }
 
@@ -205,22 +176,14 @@ fn too_few_peaks_is_reported_not_tabulated() {
     // A log that never moves: hold only.
     let mut s = String::from("time_s,disp_mm\n");
     for i in 0..400 {
-        s.push_str(&format!(
-            "{:.3},{:.3}\n",
-            i as f64 * 0.005,
-            0.01 * ((i * 7919) % 5) as f64
-        ));
+        s.push_str(&format!("{:.3},{:.3}\n", i as f64 * 0.005, 0.01 * ((i * 7919) % 5) as f64));
     }
     let (dir, manifest) = campaign(&[("still", "still.csv", Some(s.into_bytes()), "")]);
     let run = reduce(&manifest, &dir.path().join("out"), &[]);
     assert_eq!(run.code, 1);
     let e = test_entry(&run.summary, "still");
     assert_eq!(e["status"], "error");
-    assert!(
-        e["error"].as_str().unwrap().contains("no release found"),
-        "{}",
-        e["error"]
-    );
+    assert!(e["error"].as_str().unwrap().contains("no release found"), "{}", e["error"]);
     assert!(e.get("r").is_none(), "no table values for a failed test");
 }
 
@@ -258,7 +221,12 @@ fn format_invariance() {
     }
     let (dir, manifest) = campaign(&[
         ("euro", "euro.csv", Some(euro.into_bytes()), ""),
-        ("ms_m", "ms_m.csv", Some(ms_m.into_bytes()), "time = { column = \"t_ms\", unit = \"ms\" }\ndisplacement = { column = \"x_m\", unit = \"m\", height_m = 2.56 }"),
+        (
+            "ms_m",
+            "ms_m.csv",
+            Some(ms_m.into_bytes()),
+            "time = { column = \"t_ms\", unit = \"ms\" }\ndisplacement = { column = \"x_m\", unit = \"m\", height_m = 2.56 }",
+        ),
         ("neg", "neg.csv", Some(neg.into_bytes()), "outward_sign = -1"),
     ]);
     let run = reduce(&manifest, &dir.path().join("out"), &[]);
@@ -266,20 +234,12 @@ fn format_invariance() {
     let good = test_entry(&run.summary, "good").clone();
     for id in ["euro", "ms_m", "neg"] {
         let t = test_entry(&run.summary, id);
-        for k in [
-            "e", "e_plus", "e_minus", "r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2",
-        ] {
+        for k in ["e", "e_plus", "e_minus", "r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"] {
             let (a, b) = (good[k].as_f64().unwrap(), t[k].as_f64().unwrap());
             assert!((a - b).abs() < 1e-6, "{id}.{k}: {b} vs {a}");
         }
-        let (pa, pb) = (
-            &good["peaks"][0]["velocity_mm_s"],
-            &t["peaks"][0]["velocity_mm_s"],
-        );
-        assert!(
-            (pa.as_f64().unwrap() - pb.as_f64().unwrap()).abs() < 1e-3,
-            "{id}: v0 {pb} vs {pa}"
-        );
+        let (pa, pb) = (&good["peaks"][0]["velocity_mm_s"], &t["peaks"][0]["velocity_mm_s"]);
+        assert!((pa.as_f64().unwrap() - pb.as_f64().unwrap()).abs() < 1e-3, "{id}: v0 {pb} vs {pa}");
     }
 }
 
@@ -299,24 +259,107 @@ fn demo_writes_tables_and_plots() {
     assert!(stdout.contains("| 150_1 |"), "{stdout}");
     for c in ["one-sided-demo", "two-sided-demo"] {
         let d = dir.path().join(c);
-        for f in [
-            "summary.json",
-            "table1.csv",
-            "table1.md",
-            "table2.csv",
-            "table3.md",
-            "tables.md",
-        ] {
+        for f in ["summary.json", "table1.csv", "table1.md", "table2.csv", "table3.md", "tables.md"] {
             assert!(d.join(f).is_file(), "{c}/{f}");
         }
-        let s: Value =
-            serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap())
-                .unwrap();
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap();
         let first = s["tests"][0]["id"].as_str().unwrap().to_string();
         let png = std::fs::read(d.join("plots").join(format!("{first}_motion.png"))).unwrap();
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
-        let svg =
-            std::fs::read_to_string(d.join("plots").join(format!("{first}_ratios.svg"))).unwrap();
+        let svg = std::fs::read_to_string(d.join("plots").join(format!("{first}_ratios.svg"))).unwrap();
         assert!(svg.contains("<svg") && svg.contains("mean r ="));
     }
+}
+
+fn gm_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ground-motions")
+}
+
+/// Issue #3: `simulate` writes summary.json with the contract's keys, the time
+/// history and the plot; the façade under the NRC 30 Oct record ×1.27 has the
+/// paper's Table 5 PGA and PGV.
+#[test]
+fn simulate_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .args(["simulate", "--block"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml"))
+        .arg("--record")
+        .arg(gm_dir().join("esm-central-italy-2016/IT.NRC..HGE.D.20161030.064018.C.ACC.ASC"))
+        .args([
+            "--scale",
+            "1.27",
+            "--polarity",
+            "-1",
+            "--e-in",
+            "0.59",
+            "--e-out",
+            "0.68",
+            "--t-extra",
+            "2",
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    for k in [
+        "max_theta_over_alpha",
+        "min_theta_over_alpha",
+        "overturned",
+        "overturn_time_s",
+        "impacts",
+        "pga_g",
+        "pgv_cm_s",
+        "solve_wall_s",
+    ] {
+        assert!(s.get(k).is_some(), "missing {k}");
+    }
+    assert!((s["pga_g"].as_f64().unwrap() - 0.617).abs() < 0.0005);
+    assert!((s["pgv_cm_s"].as_f64().unwrap() - 61.32).abs() < 0.01);
+    if s["overturned"] == false {
+        assert!(s["overturn_time_s"].is_null());
+    }
+    let hist = std::fs::read_to_string(dir.path().join("history.csv")).unwrap();
+    assert!(hist.starts_with("t_s,theta_rad,theta_over_alpha,theta_dot_rad_s,ag_m_s2"));
+    let last_t: f64 = hist.lines().last().unwrap().split(',').next().unwrap().parse().unwrap();
+    if s["overturned"] == false {
+        assert!((last_t - 52.0).abs() < 0.01, "record 50 s + 2 s extra, ends at {last_t}");
+    }
+    assert!(dir.path().join("response.png").is_file() && dir.path().join("response.svg").is_file());
+}
+
+#[test]
+fn simulate_needs_a_coefficient_and_reports_bad_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .args(["simulate", "--block"])
+        .arg(&block)
+        .arg("--record")
+        .arg(gm_dir().join("synthetic/one_sine_pulse.csv"))
+        .args(["--units", "g", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--e"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let bad = dir.path().join("bad.txt");
+    std::fs::write(&bad, "0 0.1\n0.005 0.2\n0.010 x\n").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .args(["simulate", "--block"])
+        .arg(&block)
+        .arg("--record")
+        .arg(&bad)
+        .args(["--units", "g", "--e", "0.9", "--out"])
+        .arg(dir.path().join("o"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("bad.txt:3"), "{err}");
 }

@@ -5,9 +5,7 @@ use std::path::{Path, PathBuf};
 use rocklab::ground_motion::{parse, read, Format, ReadOptions, Units};
 
 fn gm(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/ground-motions")
-        .join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ground-motions").join(rel)
 }
 
 /// PGA and PGV of the NRC east components (SPEC and ground-motions/README: checked
@@ -17,49 +15,17 @@ fn gm(rel: &str) -> PathBuf {
 #[test]
 fn nrc_east_pga_pgv_and_table_5() {
     let cases = [
-        (
-            "IT.NRC..HGE.D.20160824.013632.C.ACC.ASC",
-            0.3595,
-            29.75,
-            0.46,
-            37.79,
-        ),
-        (
-            "IT.NRC..HGE.D.20161030.064018.C.ACC.ASC",
-            0.4858,
-            48.28,
-            0.62,
-            61.32,
-        ),
+        ("IT.NRC..HGE.D.20160824.013632.C.ACC.ASC", 0.3595, 29.75, 0.46, 37.79),
+        ("IT.NRC..HGE.D.20161030.064018.C.ACC.ASC", 0.4858, 48.28, 0.62, 61.32),
     ];
     for (file, pga, pgv, pga_t5, pgv_t5) in cases {
-        let r = read(
-            &gm(&format!("esm-central-italy-2016/{file}")),
-            &ReadOptions::default(),
-        )
-        .unwrap();
+        let r = read(&gm(&format!("esm-central-italy-2016/{file}")), &ReadOptions::default()).unwrap();
         assert_eq!(r.format, Format::Esm);
         assert_eq!(r.dt, 0.005);
-        assert!(
-            (r.pga_g(1.0) - pga).abs() <= 0.00005,
-            "{file}: PGA {}",
-            r.pga_g(1.0)
-        );
-        assert!(
-            (r.pgv_cm_s(1.0) - pgv).abs() <= 0.005,
-            "{file}: PGV {}",
-            r.pgv_cm_s(1.0)
-        );
-        assert!(
-            (r.pga_g(1.27) - pga_t5).abs() <= 0.005,
-            "{file}: scaled PGA {}",
-            r.pga_g(1.27)
-        );
-        assert!(
-            (r.pgv_cm_s(1.27) - pgv_t5).abs() <= 0.01,
-            "{file}: scaled PGV {}",
-            r.pgv_cm_s(1.27)
-        );
+        assert!((r.pga_g(1.0) - pga).abs() <= 0.00005, "{file}: PGA {}", r.pga_g(1.0));
+        assert!((r.pgv_cm_s(1.0) - pgv).abs() <= 0.005, "{file}: PGV {}", r.pgv_cm_s(1.0));
+        assert!((r.pga_g(1.27) - pga_t5).abs() <= 0.005, "{file}: scaled PGA {}", r.pga_g(1.27));
+        assert!((r.pgv_cm_s(1.27) - pgv_t5).abs() <= 0.01, "{file}: scaled PGV {}", r.pgv_cm_s(1.27));
     }
 }
 
@@ -67,11 +33,7 @@ fn nrc_east_pga_pgv_and_table_5() {
 /// 76.215 s (the file's own header says so).
 #[test]
 fn cosmos_v2() {
-    let r = read(
-        &gm("cosmos/us1000hyfh_akbmrp_AKBMR--n.1000hyfh.BNZ.--.acc.V2c"),
-        &ReadOptions::default(),
-    )
-    .unwrap();
+    let r = read(&gm("cosmos/us1000hyfh_akbmrp_AKBMR--n.1000hyfh.BNZ.--.acc.V2c"), &ReadOptions::default()).unwrap();
     assert_eq!(r.format, Format::Cosmos);
     assert_eq!(r.acc_m_s2.len(), 42000);
     assert!((r.dt - 0.005).abs() < 1e-12);
@@ -79,10 +41,7 @@ fn cosmos_v2() {
         .acc_m_s2
         .iter()
         .enumerate()
-        .fold(
-            (0, 0.0f64),
-            |b, (i, a)| if a.abs() > b.1.abs() { (i, *a) } else { b },
-        );
+        .fold((0, 0.0f64), |b, (i, a)| if a.abs() > b.1.abs() { (i, *a) } else { b });
     assert!((a * 100.0 + 6.852).abs() < 0.001, "{a}");
     assert!((i as f64 * r.dt - 76.215).abs() < 1e-9);
 }
@@ -125,9 +84,7 @@ fn two_and_one_column() {
 }
 
 fn values(n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| 0.01 * ((i as f64) * 0.7).sin() - 0.002 * i as f64 / n as f64)
-        .collect()
+    (0..n).map(|i| 0.01 * ((i as f64) * 0.7).sin() - 0.002 * i as f64 / n as f64).collect()
 }
 
 /// PEER AT2: NGA-West2 and old headers, 5 or 8 values per line, CR CR LF and CR line
@@ -141,7 +98,8 @@ fn at2_variants() {
         nga.push_str(&c.iter().map(|x| fmt15(*x)).collect::<String>());
         nga.push('\n');
     }
-    let mut old = String::from("PACIFIC ENGINEERING\r\r\nSYNTHETIC\r\r\nACCELERATION TIME HISTORY IN UNITS OF G\r\r\n    23    0.0100    NPTS, DT\r\r\n");
+    let mut old =
+        String::from("PACIFIC ENGINEERING\r\r\nSYNTHETIC\r\r\nACCELERATION TIME HISTORY IN UNITS OF G\r\r\n    23    0.0100    NPTS, DT\r\r\n");
     for c in v.chunks(8) {
         old.push_str(&c.iter().map(|x| format!("{x:10.5}")).collect::<String>());
         old.push_str("\r\r\n");
@@ -159,13 +117,8 @@ fn at2_variants() {
         })
         .collect::<Vec<_>>()
         .join("\r");
-    for (name, text, tol) in [
-        ("nga", nga, 1e-9),
-        ("old", old, 5e-6),
-        ("cr-only tight", tight, 1e-9),
-    ] {
-        let r = parse(Path::new(name), &text, &ReadOptions::default())
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+    for (name, text, tol) in [("nga", nga, 1e-9), ("old", old, 5e-6), ("cr-only tight", tight, 1e-9)] {
+        let r = parse(Path::new(name), &text, &ReadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(r.format, Format::At2, "{name}");
         assert_eq!(r.dt, 0.01, "{name}");
         assert_eq!(r.acc_m_s2.len(), 23, "{name}");
@@ -179,9 +132,7 @@ fn at2_variants() {
 #[test]
 fn malformed_files_name_the_line() {
     let text = "PEER\nx\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=      3, DT=   .0100 SEC,\n 0.1 0.2\n 0.3 zz\n";
-    let e = parse(Path::new("bad.at2"), text, &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = parse(Path::new("bad.at2"), text, &ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("bad.at2:6") && e.contains("'zz'"), "{e}");
     let text = "0 0.1\n0.01 0.2\n0.02\n";
     let e = parse(
@@ -196,15 +147,8 @@ fn malformed_files_name_the_line() {
     .to_string();
     assert!(e.contains("bad.txt:3"), "{e}");
     let text = "NDATA: 3\nSAMPLING_INTERVAL_S: 0.005\nUNITS: cm/s^2\n1\n2\n";
-    let e = parse(Path::new("cut.asc"), text, &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("cut.asc:1") && e.contains("NDATA 3 but 2"),
-        "{e}"
-    );
-    let e = read(Path::new("/nonexistent/rec.asc"), &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = parse(Path::new("cut.asc"), text, &ReadOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("cut.asc:1") && e.contains("NDATA 3 but 2"), "{e}");
+    let e = read(Path::new("/nonexistent/rec.asc"), &ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("rec.asc") && e.contains("not found"), "{e}");
 }

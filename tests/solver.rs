@@ -61,10 +61,7 @@ fn linearized_period() {
     assert!(imp.len() >= 9, "{} impacts", imp.len());
     for (k, (t, ..)) in imp.iter().enumerate() {
         let expected = period / 4.0 + k as f64 * period / 2.0;
-        assert!(
-            (t / expected - 1.0).abs() < 1e-8,
-            "impact {k}: {t} vs {expected}"
-        );
+        assert!((t / expected - 1.0).abs() < 1e-8, "impact {k}: {t} vs {expected}");
     }
 }
 
@@ -83,13 +80,7 @@ fn quarter_period_quadrature(theta0: f64) -> f64 {
         }
     };
     let (x, w) = (
-        [
-            -0.906179845938664,
-            -0.5384693101056831,
-            0.0,
-            0.5384693101056831,
-            0.906179845938664,
-        ],
+        [-0.906179845938664, -0.5384693101056831, 0.0, 0.5384693101056831, 0.906179845938664],
         [
             0.23692688505618908,
             0.47862867049936647,
@@ -122,20 +113,12 @@ fn nonlinear_period_and_energy() {
     assert!(imp.len() >= 4);
     for (k, (t, ..)) in imp.iter().enumerate() {
         let expected = q * (1 + 2 * k) as f64;
-        assert!(
-            (t / expected - 1.0).abs() < 1e-8,
-            "impact {k}: {t} vs {expected}"
-        );
+        assert!((t / expected - 1.0).abs() < 1e-8, "impact {k}: {t} vs {expected}");
     }
     let e0 = m.energy(theta0, 0.0);
     for s in &sim.history {
         let e = m.energy(s.theta, s.omega);
-        assert!(
-            (e / e0 - 1.0).abs() < 1e-9,
-            "energy drift at t = {}: {}",
-            s.t,
-            e / e0 - 1.0
-        );
+        assert!((e / e0 - 1.0).abs() < 1e-9, "energy drift at t = {}: {}", s.t, e / e0 - 1.0);
     }
 }
 
@@ -172,11 +155,7 @@ fn impacts_and_amplitudes() {
         let c = 0.5 * va * va / P2 + ALPHA.cos();
         -(ALPHA - c.acos())
     };
-    assert!(
-        (sim.min_theta / first_inward - 1.0).abs() < 1e-8,
-        "{} vs {first_inward}",
-        sim.min_theta
-    );
+    assert!((sim.min_theta / first_inward - 1.0).abs() < 1e-8, "{} vs {first_inward}", sim.min_theta);
 }
 
 /// Constant ground acceleration 0.1 % below g tan α: no motion; 0.1 % above:
@@ -185,12 +164,7 @@ fn impacts_and_amplitudes() {
 fn uplift_threshold() {
     let m = model(0.9, 0.9, false);
     let thr = G * ALPHA.tan();
-    for (a, moves) in [
-        (0.999 * thr, false),
-        (1.001 * thr, true),
-        (-0.999 * thr, false),
-        (-1.001 * thr, true),
-    ] {
+    for (a, moves) in [(0.999 * thr, false), (1.001 * thr, true), (-0.999 * thr, false), (-1.001 * thr, true)] {
         let g = Ground {
             t0: 0.0,
             dt: 0.5,
@@ -221,9 +195,7 @@ fn uplift_time_under_a_sine_pulse() {
     let m = model(0.9, 0.9, false);
     let (ap, wp) = (2.0 * G * ALPHA.tan(), 2.0 * std::f64::consts::PI / 0.5);
     let dt = 1e-4;
-    let acc: Vec<f64> = (0..=5000)
-        .map(|i| ap * (wp * i as f64 * dt).sin())
-        .collect();
+    let acc: Vec<f64> = (0..=5000).map(|i| ap * (wp * i as f64 * dt).sin()).collect();
     let g = Ground { t0: 0.0, dt, acc };
     let sim = simulate(&m, &g, 0.0, None, &Settings::new(0.3));
     let t_up = sim.events.iter().find_map(|e| match e {
@@ -255,14 +227,7 @@ fn rectangular_pulse_overturning() {
         let mut acc = vec![a; n + 1];
         acc.extend(std::iter::repeat_n(0.0, 10));
         let g = Ground { t0: 0.0, dt, acc };
-        simulate(
-            &m,
-            &g,
-            0.0,
-            None,
-            &Settings::new(td + 15.0).without_history(),
-        )
-        .stop
+        simulate(&m, &g, 0.0, None, &Settings::new(td + 15.0).without_history()).stop
     };
     assert!(matches!(run(1.002, true), Stop::Overturned { .. }));
     assert_eq!(run(0.998, true), Stop::End);
@@ -276,17 +241,8 @@ fn rectangular_pulse_overturning() {
 fn one_sided_free_rocking_ends_at_rest() {
     let mut m = model(0.6, 0.7, false);
     m.restraint = Restraint::Rotational { k_nm_per_rad: 60.0 };
-    let sim = simulate(
-        &m,
-        &quiet(),
-        0.0,
-        Some([0.5 * ALPHA, 0.0]),
-        &Settings::new(60.0),
-    );
-    assert!(
-        sim.events.iter().any(|e| matches!(e, Event::Rest { .. })),
-        "never came to rest"
-    );
+    let sim = simulate(&m, &quiet(), 0.0, Some([0.5 * ALPHA, 0.0]), &Settings::new(60.0));
+    assert!(sim.events.iter().any(|e| matches!(e, Event::Rest { .. })), "never came to rest");
     assert_eq!(sim.stop, Stop::End);
     assert!(sim.min_theta > -0.05 && sim.min_theta < 0.0);
     assert!(sim.steps < 200_000, "{} steps", sim.steps);

@@ -14,25 +14,14 @@ use rocklab::reduce::reduce_campaign;
 const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
 
 fn max_errors(name: &str) -> Vec<(String, f64)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/campaigns")
-        .join(name);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    let truth: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let res = reduce_campaign(campaign, PeakOptions::default());
     let mut worst = vec![0.0f64; KEYS.len()];
     for t in &res.tests {
-        let r = t
-            .result
-            .as_ref()
-            .unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
-        let tt = truth["tests"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|x| x["id"] == t.spec.id.as_str())
-            .unwrap();
+        let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
         let c = serde_json::to_value(r.coefficients).unwrap();
         let mut line = format!("{:8}", t.spec.id);
         for (i, k) in KEYS.iter().enumerate() {
@@ -75,17 +64,11 @@ fn robust_to_decimation_spikes_clock_offset_and_drift() {
     use rocklab::restitution::coefficients;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/one-sided-demo");
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    let truth: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     for id in ["150_2", "100_1"] {
         let spec = campaign.tests.iter().find(|t| t.id == id).unwrap();
         let log = read_log(spec).unwrap();
-        let tt = truth["tests"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|x| x["id"] == id)
-            .unwrap();
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == id).unwrap();
         let variants: Vec<(&str, Vec<f64>, Vec<f64>)> = vec![
             (
                 "100 Hz",
@@ -102,16 +85,11 @@ fn robust_to_decimation_spikes_clock_offset_and_drift() {
             (
                 "clock offset + drift",
                 log.time_s.iter().map(|t| t + 1234.5).collect(),
-                log.time_s
-                    .iter()
-                    .zip(&log.disp_mm)
-                    .map(|(t, x)| x + 0.02 * t)
-                    .collect(),
+                log.time_s.iter().zip(&log.disp_mm).map(|(t, x)| x + 0.02 * t).collect(),
             ),
         ];
         for (name, t, x) in variants {
-            let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default())
-                .unwrap_or_else(|e| panic!("{id} {name}: {e}"));
+            let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default()).unwrap_or_else(|e| panic!("{id} {name}: {e}"));
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
             let c = serde_json::to_value(coefficients(&v, campaign.e_housner).unwrap()).unwrap();
             for k in KEYS {

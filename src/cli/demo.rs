@@ -10,19 +10,11 @@ use rocklab::peaks::PeakOptions;
 pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let mut ok = true;
     for name in ["one-sided-demo", "two-sided-demo"] {
-        let manifest = args
-            .fixtures
-            .join("campaigns")
-            .join(name)
-            .join("campaign.toml");
+        let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_and_write(campaign, PeakOptions::default(), &args.out.join(name), true)?;
         ok &= res.failed().next().is_none();
         say("");
     }
-    Ok(if ok {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

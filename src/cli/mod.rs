@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 
 mod demo;
 mod reduce;
+mod simulate;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -24,6 +25,8 @@ struct Cli {
 enum Command {
     /// Reduce a free-vibration campaign: peaks, Eq. 3/4 coefficients, Tables 1–3, plots.
     Reduce(ReduceArgs),
+    /// Rocking response of a block to a ground-motion record (paper Eq. 1).
+    Simulate(simulate::SimulateArgs),
     /// Reduce the fixture campaigns shipped in `fixtures/` into `reports/demo/`.
     Demo(DemoArgs),
 }
@@ -77,6 +80,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
         Command::Reduce(a) => reduce::run(a),
+        Command::Simulate(a) => simulate::run_cli(a),
         Command::Demo(a) => demo::run(a),
     }
 }

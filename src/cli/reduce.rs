@@ -14,9 +14,7 @@ use rocklab::signal::savgol::SavGol;
 pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
     let method = match e.method {
         MethodArg::Segments => Method::Segments,
-        MethodArg::Savgol => {
-            Method::SavGol(SavGol::new(e.window, e.order).map_err(anyhow::Error::msg)?)
-        }
+        MethodArg::Savgol => Method::SavGol(SavGol::new(e.window, e.order).map_err(anyhow::Error::msg)?),
     };
     Ok(PeakOptions { n_peaks: 6, method })
 }
@@ -29,12 +27,7 @@ pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {
 }
 
 /// Reduce a campaign, write every output and print the summary; shared by `demo`.
-pub fn reduce_and_write(
-    campaign: Campaign,
-    opts: PeakOptions,
-    out: &std::path::Path,
-    plots: bool,
-) -> anyhow::Result<CampaignResult> {
+pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::Path, plots: bool) -> anyhow::Result<CampaignResult> {
     say(&format!(
         "campaign {} ({}), {} tests; α = {:.4} rad ({}); e_H = {:.4} ({})",
         campaign.name,
@@ -46,8 +39,7 @@ pub fn reduce_and_write(
         campaign.e_housner_source
     ));
     let res = reduce_campaign(campaign, opts);
-    report::write_reduce_outputs(&res, out, plots)
-        .with_context(|| format!("writing {}", out.display()))?;
+    report::write_reduce_outputs(&res, out, plots).with_context(|| format!("writing {}", out.display()))?;
     for t in &res.tests {
         for w in &t.warnings {
             eprintln!("warning: test {}: {w}", t.spec.id);

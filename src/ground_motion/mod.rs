@@ -99,9 +99,7 @@ fn err(path: &Path, line: usize, message: impl Into<String>) -> InputError {
 pub fn read(path: &Path, opts: &ReadOptions) -> Result<Record, InputError> {
     let bytes = std::fs::read(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
-            InputError::Missing {
-                file: path.to_path_buf(),
-            }
+            InputError::Missing { file: path.to_path_buf() }
         } else {
             InputError::Io {
                 file: path.to_path_buf(),
@@ -129,11 +127,7 @@ fn lines(text: &str) -> Vec<&str> {
 /// Detect the format from the text.
 pub fn detect(text: &str) -> Option<Format> {
     let ls = lines(text);
-    if ls
-        .iter()
-        .take(100)
-        .any(|l| l.starts_with("SAMPLING_INTERVAL_S:"))
-    {
+    if ls.iter().take(100).any(|l| l.starts_with("SAMPLING_INTERVAL_S:")) {
         return Some(Format::Esm);
     }
     if ls
@@ -142,15 +136,10 @@ pub fn detect(text: &str) -> Option<Format> {
     {
         return Some(Format::Cosmos);
     }
-    if ls
-        .get(3)
-        .is_some_and(|l| l.to_ascii_uppercase().contains("NPTS"))
-    {
+    if ls.get(3).is_some_and(|l| l.to_ascii_uppercase().contains("NPTS")) {
         return Some(Format::At2);
     }
-    let first_data = ls
-        .iter()
-        .find(|l| !l.trim().is_empty() && numbers(l).is_ok())?;
+    let first_data = ls.iter().find(|l| !l.trim().is_empty() && numbers(l).is_ok())?;
     match numbers(first_data).ok()?.len() {
         1 => Some(Format::OneColumn),
         2 => Some(Format::TwoColumn),
@@ -199,17 +188,16 @@ pub fn parse(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record, Inpu
         }
     }
     let header_units = matches!(format, Format::Esm | Format::At2 | Format::Cosmos);
-    let units =
-        match (opts.units, header_units) {
-            (Some(u), _) => u,
-            (None, true) => rec.units,
-            (None, false) => return Err(InputError::File {
+    let units = match (opts.units, header_units) {
+        (Some(u), _) => u,
+        (None, true) => rec.units,
+        (None, false) => {
+            return Err(InputError::File {
                 file: path.to_path_buf(),
-                message:
-                    "the units of a column record are not in the file: pass --units g|m/s2|cm/s2"
-                        .into(),
-            }),
-        };
+                message: "the units of a column record are not in the file: pass --units g|m/s2|cm/s2".into(),
+            })
+        }
+    };
     if !(rec.dt > 0.0 && rec.dt.is_finite()) {
         return Err(InputError::File {
             file: path.to_path_buf(),
@@ -237,10 +225,7 @@ fn numbers(line: &str) -> Result<Vec<f64>, String> {
     let mut tok = String::new();
     let flush = |tok: &mut String, out: &mut Vec<f64>| -> Result<(), String> {
         if !tok.is_empty() {
-            let v: f64 = tok
-                .replace(['D', 'd'], "E")
-                .parse()
-                .map_err(|_| format!("'{tok}' is not a number"))?;
+            let v: f64 = tok.replace(['D', 'd'], "E").parse().map_err(|_| format!("'{tok}' is not a number"))?;
             if !v.is_finite() {
                 return Err(format!("'{tok}' is not a finite number"));
             }
@@ -253,10 +238,7 @@ fn numbers(line: &str) -> Result<Vec<f64>, String> {
     for c in line.chars() {
         if c.is_whitespace() || c == ',' || c == ';' {
             flush(&mut tok, &mut out)?;
-        } else if (c == '-' || c == '+')
-            && !tok.is_empty()
-            && !matches!(prev, 'E' | 'e' | 'D' | 'd')
-        {
+        } else if (c == '-' || c == '+') && !tok.is_empty() && !matches!(prev, 'E' | 'e' | 'D' | 'd') {
             flush(&mut tok, &mut out)?;
             tok.push(c);
         } else {
@@ -269,49 +251,28 @@ fn numbers(line: &str) -> Result<Vec<f64>, String> {
 }
 
 /// All numbers from line `from` (0-based) to the end, with the line of each.
-fn values_from(
-    path: &Path,
-    ls: &[&str],
-    from: usize,
-    stop_at: Option<&str>,
-) -> Result<Vec<f64>, InputError> {
+fn values_from(path: &Path, ls: &[&str], from: usize, stop_at: Option<&str>) -> Result<Vec<f64>, InputError> {
     let mut out = Vec::new();
     for (i, l) in ls.iter().enumerate().skip(from) {
         if stop_at.is_some_and(|s| l.starts_with(s)) {
             break;
         }
-        out.extend(
-            numbers(l)
-                .map_err(|m| err(path, i + 1, format!("{m}: expected acceleration values")))?,
-        );
+        out.extend(numbers(l).map_err(|m| err(path, i + 1, format!("{m}: expected acceleration values")))?);
     }
     Ok(out)
 }
 
 fn header_value<'a>(ls: &[&'a str], key: &str) -> Option<(usize, &'a str)> {
-    ls.iter()
-        .enumerate()
-        .find_map(|(i, l)| l.strip_prefix(key).map(|v| (i, v.trim())))
+    ls.iter().enumerate().find_map(|(i, l)| l.strip_prefix(key).map(|v| (i, v.trim())))
 }
 
 fn esm(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
-    let (li, dt_s) = header_value(ls, "SAMPLING_INTERVAL_S:")
-        .ok_or_else(|| err(path, 1, "no SAMPLING_INTERVAL_S header"))?;
-    let dt: f64 = dt_s.parse().map_err(|_| {
-        err(
-            path,
-            li + 1,
-            format!("SAMPLING_INTERVAL_S '{dt_s}' is not a number"),
-        )
-    })?;
+    let (li, dt_s) = header_value(ls, "SAMPLING_INTERVAL_S:").ok_or_else(|| err(path, 1, "no SAMPLING_INTERVAL_S header"))?;
+    let dt: f64 = dt_s
+        .parse()
+        .map_err(|_| err(path, li + 1, format!("SAMPLING_INTERVAL_S '{dt_s}' is not a number")))?;
     let units = match header_value(ls, "UNITS:") {
-        Some((ui, u)) => Units::parse(u).ok_or_else(|| {
-            err(
-                path,
-                ui + 1,
-                format!("UNITS '{u}': expected cm/s^2, m/s^2 or g"),
-            )
-        })?,
+        Some((ui, u)) => Units::parse(u).ok_or_else(|| err(path, ui + 1, format!("UNITS '{u}': expected cm/s^2, m/s^2 or g")))?,
         None => return Err(err(path, 1, "no UNITS header")),
     };
     let first = ls
@@ -321,14 +282,7 @@ fn esm(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     let vals = values_from(path, ls, first, None)?;
     if let Some((ni, n)) = header_value(ls, "NDATA:") {
         if n.parse::<usize>().ok() != Some(vals.len()) {
-            return Err(err(
-                path,
-                ni + 1,
-                format!(
-                    "NDATA {n} but {} values follow (truncated file?)",
-                    vals.len()
-                ),
-            ));
+            return Err(err(path, ni + 1, format!("NDATA {n} but {} values follow (truncated file?)", vals.len())));
         }
     }
     let mut notes = Vec::new();
@@ -357,11 +311,7 @@ fn esm(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
 
 fn at2(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     if ls.len() < 5 {
-        return Err(err(
-            path,
-            ls.len().max(1),
-            "an AT2 file has 4 header lines, then values",
-        ));
+        return Err(err(path, ls.len().max(1), "an AT2 file has 4 header lines, then values"));
     }
     let units = if ls[2].to_ascii_uppercase().contains("UNITS OF G") {
         Units::G
@@ -373,11 +323,7 @@ fn at2(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     {
         u
     } else {
-        return Err(err(
-            path,
-            3,
-            "expected 'UNITS OF G' on the third header line",
-        ));
+        return Err(err(path, 3, "expected 'UNITS OF G' on the third header line"));
     };
     let h = ls[3].to_ascii_uppercase();
     let (npts, dt) = if h.contains("NPTS=") || h.contains("NPTS =") {
@@ -386,9 +332,7 @@ fn at2(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
             let rest = rest.trim_start_matches([' ', '=']);
             let num: String = rest
                 .chars()
-                .take_while(|c| {
-                    c.is_ascii_digit() || *c == '.' || *c == 'E' || *c == '-' || *c == '+'
-                })
+                .take_while(|c| c.is_ascii_digit() || *c == '.' || *c == 'E' || *c == '-' || *c == '+')
                 .collect();
             num.parse().ok()
         };
@@ -399,21 +343,11 @@ fn at2(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     };
     let (npts, dt) = match (npts, dt) {
         (Some(n), Some(d)) => (n as usize, d),
-        _ => {
-            return Err(err(
-                path,
-                4,
-                format!("cannot read NPTS and DT from '{}'", ls[3].trim()),
-            ))
-        }
+        _ => return Err(err(path, 4, format!("cannot read NPTS and DT from '{}'", ls[3].trim()))),
     };
     let vals = values_from(path, ls, 4, None)?;
     if vals.len() != npts {
-        return Err(err(
-            path,
-            ls.len(),
-            format!("NPTS = {npts} but {} values were read", vals.len()),
-        ));
+        return Err(err(path, ls.len(), format!("NPTS = {npts} but {} values were read", vals.len())));
     }
     Ok(Record {
         path: path.into(),
@@ -439,16 +373,9 @@ fn cosmos(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     let nint = count_of(i, "integer-header values")?;
     i += 1 + nint.div_ceil(10);
     let nreal = count_of(i, "real-header values")?;
-    let reals = values_from(
-        path,
-        &ls[..(i + 1 + nreal.div_ceil(5)).min(ls.len())],
-        i + 1,
-        None,
-    )?;
+    let reals = values_from(path, &ls[..(i + 1 + nreal.div_ceil(5)).min(ls.len())], i + 1, None)?;
     i += 1 + nreal.div_ceil(5);
-    let dt_ms = *reals
-        .get(61)
-        .ok_or_else(|| err(path, i, "real header #62 (sampling interval) missing"))?;
+    let dt_ms = *reals.get(61).ok_or_else(|| err(path, i, "real header #62 (sampling interval) missing"))?;
     let ncom = count_of(i, "comment lines")?;
     i += 1 + ncom;
     let npts = count_of(i, "acceleration points")?;
@@ -458,19 +385,11 @@ fn cosmos(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
     } else if units_line.contains("units=g") {
         Units::G
     } else {
-        return Err(err(
-            path,
-            i + 1,
-            "units not recognised (expected cm/sec2 or g)",
-        ));
+        return Err(err(path, i + 1, "units not recognised (expected cm/sec2 or g)"));
     };
     let vals = values_from(path, ls, i + 1, Some("End-of-data"))?;
     if vals.len() != npts {
-        return Err(err(
-            path,
-            i + 1,
-            format!("{npts} points announced but {} read", vals.len()),
-        ));
+        return Err(err(path, i + 1, format!("{npts} points announced but {} read", vals.len())));
     }
     Ok(Record {
         path: path.into(),
@@ -497,14 +416,9 @@ fn column_values(path: &Path, ls: &[&str], col: usize) -> Result<(Vec<f64>, Vec<
         if l.trim().is_empty() {
             continue;
         }
-        let v =
-            numbers(l).map_err(|m| err(path, i + 1, format!("{m}: expected {width} number(s)")))?;
+        let v = numbers(l).map_err(|m| err(path, i + 1, format!("{m}: expected {width} number(s)")))?;
         if v.len() != width {
-            return Err(err(
-                path,
-                i + 1,
-                format!("{} values: expected {width}", v.len()),
-            ));
+            return Err(err(path, i + 1, format!("{} values: expected {width}", v.len())));
         }
         a.push(v[col]);
         if width > 1 {
@@ -524,7 +438,11 @@ fn two_column(path: &Path, ls: &[&str]) -> Result<Record, InputError> {
         if ((w[1] - w[0]) - dt).abs() > 1e-6 * dt.max(1e-12) + 1e-9 {
             return Err(InputError::File {
                 file: path.to_path_buf(),
-                message: format!("time step changes at sample {} ({} s, expected {dt} s): uniform sampling expected", k + 2, w[1] - w[0]),
+                message: format!(
+                    "time step changes at sample {} ({} s, expected {dt} s): uniform sampling expected",
+                    k + 2,
+                    w[1] - w[0]
+                ),
             });
         }
     }
@@ -545,10 +463,7 @@ mod tests {
 
     #[test]
     fn run_together_fortran_numbers() {
-        assert_eq!(
-            numbers("-.12E-03-.34E+02 .5").unwrap(),
-            vec![-0.12e-3, -0.34e2, 0.5]
-        );
+        assert_eq!(numbers("-.12E-03-.34E+02 .5").unwrap(), vec![-0.12e-3, -0.34e2, 0.5]);
         assert!(numbers("1.2.3").is_err());
     }
 }

@@ -107,9 +107,7 @@ impl LogReader {
     pub fn read(&self) -> Result<LogData, InputError> {
         let bytes = std::fs::read(&self.path).map_err(|e| {
             if e.kind() == std::io::ErrorKind::NotFound {
-                InputError::Missing {
-                    file: self.path.clone(),
-                }
+                InputError::Missing { file: self.path.clone() }
             } else {
                 InputError::Io {
                     file: self.path.clone(),
@@ -152,10 +150,7 @@ impl LogReader {
         }
         // The csv reader does not count skipped '#' lines in the header's position.
         let header_line = header_line_number(bytes);
-        let names: Vec<String> = rec
-            .iter()
-            .map(|f| String::from_utf8_lossy(f).trim().to_string())
-            .collect();
+        let names: Vec<String> = rec.iter().map(|f| String::from_utf8_lossy(f).trim().to_string()).collect();
         let find = |name: &str, what: &str| {
             names.iter().position(|n| n == name).ok_or_else(|| InputError::Line {
                 file: file.clone(),
@@ -198,21 +193,15 @@ impl LogReader {
                         ),
                     });
                 }
-                let t = parse_cell(rec.get(it).unwrap_or(b""), decimal, &mut buf)
-                    .map_err(|m| at(file, line, it, &self.time_column, m))?;
-                let x = parse_cell(rec.get(id).unwrap_or(b""), decimal, &mut buf)
-                    .map_err(|m| at(file, line, id, &self.disp_column, m))?;
+                let t = parse_cell(rec.get(it).unwrap_or(b""), decimal, &mut buf).map_err(|m| at(file, line, it, &self.time_column, m))?;
+                let x = parse_cell(rec.get(id).unwrap_or(b""), decimal, &mut buf).map_err(|m| at(file, line, id, &self.disp_column, m))?;
                 Ok((t * self.time_scale, x * self.disp_scale, t))
             })();
             match row {
                 Ok((t, x, t_raw)) => {
                     if let Some(&prev) = data.time_s.last() {
                         if t <= prev {
-                            let what = if t == prev {
-                                "duplicated"
-                            } else {
-                                "decreasing"
-                            };
+                            let what = if t == prev { "duplicated" } else { "decreasing" };
                             return Err(at(
                                 file,
                                 line,
@@ -250,11 +239,7 @@ impl LogReader {
         Ok(data)
     }
 
-    fn resolve_format(
-        &self,
-        bytes: &[u8],
-        notes: &mut Vec<String>,
-    ) -> Result<(Delimiter, Decimal), InputError> {
+    fn resolve_format(&self, bytes: &[u8], notes: &mut Vec<String>) -> Result<(Delimiter, Decimal), InputError> {
         let mut lines = bytes
             .split(|b| *b == b'\n')
             .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
@@ -289,8 +274,7 @@ impl LogReader {
                 d
             }
             None => {
-                let d = if delimiter != Delimiter::Comma && sample.iter().any(|l| l.contains(&b','))
-                {
+                let d = if delimiter != Delimiter::Comma && sample.iter().any(|l| l.contains(&b',')) {
                     Decimal::Comma
                 } else {
                     Decimal::Point
@@ -347,8 +331,7 @@ fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, S
     if text.is_empty() {
         return Err("empty cell: expected a number".into());
     }
-    let s = std::str::from_utf8(text)
-        .map_err(|_| format!("'{}' is not text: expected a number", shown()))?;
+    let s = std::str::from_utf8(text).map_err(|_| format!("'{}' is not text: expected a number", shown()))?;
     let v: f64 = s.parse().map_err(|_| {
         let hint = match decimal {
             Decimal::Point if s.contains(',') => " (a decimal comma? set [format].decimal = \",\")",
@@ -357,10 +340,7 @@ fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, S
         format!("'{}' is not a number{hint}", shown())
     })?;
     if !v.is_finite() {
-        return Err(format!(
-            "'{}' is not a finite number: expected a measured value",
-            shown()
-        ));
+        return Err(format!("'{}' is not a finite number: expected a measured value", shown()));
     }
     Ok(v)
 }
@@ -375,9 +355,7 @@ mod tests {
 
     #[test]
     fn reads_metadata_header_and_rows() {
-        let d = reader()
-            .parse(b"# a\n# b\ntime_s,disp_mm,acc\n0.0,1.5,9\n0.005,1.25,9\n")
-            .unwrap();
+        let d = reader().parse(b"# a\n# b\ntime_s,disp_mm,acc\n0.0,1.5,9\n0.005,1.25,9\n").unwrap();
         assert_eq!(d.time_s, vec![0.0, 0.005]);
         assert_eq!(d.disp_mm, vec![1.5, 1.25]);
     }
@@ -411,10 +389,7 @@ mod tests {
 
     #[test]
     fn non_numeric_cell_names_line_and_column() {
-        let e = reader()
-            .parse(b"#m\ntime_s,disp_mm\n0,1\n0.1,abc\n")
-            .unwrap_err()
-            .to_string();
+        let e = reader().parse(b"#m\ntime_s,disp_mm\n0,1\n0.1,abc\n").unwrap_err().to_string();
         assert!(e.contains("t.csv:4:2"), "{e}");
         assert!(e.contains("'abc' is not a number"), "{e}");
     }
@@ -423,10 +398,6 @@ mod tests {
     fn truncated_last_line_is_dropped_with_a_warning() {
         let d = reader().parse(b"time_s,disp_mm\n0,1\n0.1,2\n0.2").unwrap();
         assert_eq!(d.time_s.len(), 2);
-        assert!(
-            d.warnings[0].contains(":4: truncated last line"),
-            "{:?}",
-            d.warnings
-        );
+        assert!(d.warnings[0].contains(":4: truncated last line"), "{:?}", d.warnings);
     }
 }

@@ -210,8 +210,7 @@ impl Campaign {
     /// Parse and validate manifest text; `path` names it in errors and resolves the
     /// test files.
     pub fn parse(text: &str, path: &Path) -> anyhow::Result<Campaign> {
-        let raw: RawManifest = toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let raw: RawManifest = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
         validate(raw, path)
     }
 }
@@ -224,10 +223,7 @@ fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(bad(
-            path,
-            format!("{key} = {v}: expected a positive number"),
-        ))
+        Err(bad(path, format!("{key} = {v}: expected a positive number")))
     }
 }
 
@@ -235,10 +231,7 @@ fn sign(path: &Path, where_: &str, v: i64) -> anyhow::Result<f64> {
     match v {
         1 => Ok(1.0),
         -1 => Ok(-1.0),
-        _ => Err(bad(
-            path,
-            format!("{where_}outward_sign = {v}: expected 1 or -1"),
-        )),
+        _ => Err(bad(path, format!("{where_}outward_sign = {v}: expected 1 or -1"))),
     }
 }
 
@@ -248,23 +241,13 @@ fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> anyhow::Result<LogF
         Some(",") => Some(Delimiter::Comma),
         Some(";") => Some(Delimiter::Semicolon),
         Some("\t") | Some("\\t") | Some("tab") => Some(Delimiter::Tab),
-        Some(other) => {
-            return Err(bad(
-                path,
-                format!("{where_}delimiter = {other:?}: expected \",\", \";\" or \"\\t\""),
-            ))
-        }
+        Some(other) => return Err(bad(path, format!("{where_}delimiter = {other:?}: expected \",\", \";\" or \"\\t\""))),
     };
     let decimal = match f.decimal.as_deref() {
         None => None,
         Some(".") => Some(Decimal::Point),
         Some(",") => Some(Decimal::Comma),
-        Some(other) => {
-            return Err(bad(
-                path,
-                format!("{where_}decimal = {other:?}: expected \".\" or \",\""),
-            ))
-        }
+        Some(other) => return Err(bad(path, format!("{where_}decimal = {other:?}: expected \".\" or \",\""))),
     };
     if delimiter == Some(Delimiter::Comma) && decimal == Some(Decimal::Comma) {
         return Err(bad(
@@ -282,19 +265,13 @@ fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
     if !(w.hinge_height_m.is_finite() && w.hinge_height_m >= 0.0 && w.hinge_height_m < height_m) {
         return Err(bad(
             path,
-            format!(
-                "[wall].hinge_height_m = {}: expected 0 ≤ hinge < height ({height_m})",
-                w.hinge_height_m
-            ),
+            format!("[wall].hinge_height_m = {}: expected 0 ≤ hinge < height ({height_m})", w.hinge_height_m),
         ));
     }
     let (alpha_rad, alpha_source) = match w.alpha_rad {
         Some(a) => {
             if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
-                return Err(bad(
-                    path,
-                    format!("[wall].alpha_rad = {a}: expected 0 < α < π/2"),
-                ));
+                return Err(bad(path, format!("[wall].alpha_rad = {a}: expected 0 < α < π/2")));
             }
             (a, Provenance::Override("[wall].alpha_rad".into()))
         }
@@ -306,17 +283,11 @@ fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
     let (e_housner, e_housner_source) = match w.e_housner {
         Some(e) => {
             if !(e > 0.0 && e <= 1.0) {
-                return Err(bad(
-                    path,
-                    format!("[wall].e_housner = {e}: expected 0 < e_H ≤ 1"),
-                ));
+                return Err(bad(path, format!("[wall].e_housner = {e}: expected 0 < e_H ≤ 1")));
             }
             (e, Provenance::Override("[wall].e_housner".into()))
         }
-        None => (
-            housner_e(alpha_rad),
-            Provenance::Computed(format!("Eq. 2, 1 − 1.5 sin²({alpha_rad:.4})")),
-        ),
+        None => (housner_e(alpha_rad), Provenance::Computed(format!("Eq. 2, 1 − 1.5 sin²({alpha_rad:.4})"))),
     };
     let defaults = raw.channels.clone().unwrap_or_default();
     let campaign_format = match &raw.format {
@@ -343,42 +314,35 @@ fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
             .clone()
             .or(nested.time)
             .or(defaults.time.clone())
-            .ok_or_else(|| {
-                bad(
-                    path,
-                    format!(
-                        "{where_}no time channel: set [channels].time or time in this [[test]]"
-                    ),
-                )
-            })?;
+            .ok_or_else(|| bad(path, format!("{where_}no time channel: set [channels].time or time in this [[test]]")))?;
         let displacement = t
             .displacement
             .clone()
             .or(nested.displacement)
             .or(defaults.displacement.clone())
             .ok_or_else(|| {
-                bad(path, format!("{where_}no displacement channel: set [channels].displacement or displacement in this [[test]]"))
+                bad(
+                    path,
+                    format!("{where_}no displacement channel: set [channels].displacement or displacement in this [[test]]"),
+                )
             })?;
         let outward_sign = sign(
             path,
             &where_,
-            t.outward_sign
-                .or(nested.outward_sign)
-                .or(defaults.outward_sign)
-                .unwrap_or(1),
+            t.outward_sign.or(nested.outward_sign).or(defaults.outward_sign).unwrap_or(1),
         )?;
         let sensor_h = displacement.height_m.ok_or_else(|| {
-            bad(path, format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"))
+            bad(
+                path,
+                format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"),
+            )
         })?;
         let sensor_h = positive(path, "displacement.height_m", sensor_h)?;
         let lever_arm_m = sensor_h - w.hinge_height_m;
         if lever_arm_m <= 0.0 {
             return Err(bad(
                 path,
-                format!(
-                    "{where_}sensor height {sensor_h} m is not above the hinge ({} m)",
-                    w.hinge_height_m
-                ),
+                format!("{where_}sensor height {sensor_h} m is not above the hinge ({} m)", w.hinge_height_m),
             ));
         }
         let format = match &t.format {
@@ -460,19 +424,14 @@ time = { column = "t_ms", unit = "ms" }
     #[test]
     fn unknown_key_is_named() {
         let text = BASE.replace("hinge_height_m = 0.23", "hinge_height_m = 0.23\nhieght = 3");
-        let err = Campaign::parse(&text, Path::new("m.toml"))
-            .unwrap_err()
-            .to_string();
+        let err = Campaign::parse(&text, Path::new("m.toml")).unwrap_err().to_string();
         assert!(err.contains("hieght"), "{err}");
         assert!(err.contains("m.toml"), "{err}");
     }
 
     #[test]
     fn overrides_are_recorded() {
-        let text = BASE.replace(
-            "hinge_height_m = 0.23",
-            "hinge_height_m = 0.23\nalpha_rad = 0.12\ne_housner = 0.97",
-        );
+        let text = BASE.replace("hinge_height_m = 0.23", "hinge_height_m = 0.23\nalpha_rad = 0.12\ne_housner = 0.97");
         let c = Campaign::parse(&text, Path::new("m.toml")).unwrap();
         assert_eq!(c.alpha_rad, 0.12);
         assert_eq!(c.e_housner, 0.97);
@@ -482,9 +441,7 @@ time = { column = "t_ms", unit = "ms" }
     #[test]
     fn bad_sign_and_format_are_rejected() {
         let text = BASE.replace("outward_sign = -1", "outward_sign = 2");
-        let err = Campaign::parse(&text, Path::new("m.toml"))
-            .unwrap_err()
-            .to_string();
+        let err = Campaign::parse(&text, Path::new("m.toml")).unwrap_err().to_string();
         assert!(err.contains("outward_sign = 2"), "{err}");
         let text = format!("{BASE}\n[format]\ndelimiter = \"|\"\n");
         assert!(Campaign::parse(&text, Path::new("m.toml")).is_err());

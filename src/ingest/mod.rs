@@ -1,5 +1,6 @@
 //! The input edge: the campaign manifest and the displacement logs.
 
+pub mod block;
 pub mod log;
 pub mod manifest;
 

@@ -29,10 +29,7 @@ pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) 
         md.push_str(&one);
         md.push('\n');
     }
-    md.push_str(&format!(
-        "Velocity peaks: {}.\n",
-        res.options.method.describe()
-    ));
+    md.push_str(&format!("Velocity peaks: {}.\n", res.options.method.describe()));
     write_atomic(&out.join("tables.md"), md.as_bytes())?;
     if with_plots {
         let dir = out.join("plots");
@@ -50,10 +47,7 @@ pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) 
 fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
     let a = &r.analysis;
     let t = &r.log.time_s;
-    let last = a
-        .impacts
-        .last()
-        .map_or(a.release_time_s + 1.0, |i| i.time_s);
+    let last = a.impacts.last().map_or(a.release_time_s + 1.0, |i| i.time_s);
     let span = last - a.release_time_s;
     let (t0, t1) = (a.release_time_s - 0.15 * span, last + 0.25 * span);
     let window = |i: &usize| t[*i] >= t0 && t[*i] <= t1;
@@ -62,11 +56,7 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
     let velocity: Vec<(f64, f64)> = idx.iter().map(|&i| (t[i], a.velocity_mm_s[i])).collect();
     let fit_x: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.1)).collect();
     let fit_v: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.2)).collect();
-    let peaks: Vec<(f64, f64)> = a
-        .peaks
-        .iter()
-        .map(|p| (p.time_s, p.velocity_mm_s))
-        .collect();
+    let peaks: Vec<(f64, f64)> = a.peaks.iter().map(|p| (p.time_s, p.velocity_mm_s)).collect();
     let mut disp = vec![Series {
         label: "measured (zero: final rest line)".into(),
         color: plots::GREY,
@@ -106,6 +96,7 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
             y_label: "displacement (mm)".into(),
             series: disp,
             hline: None,
+            x_range: None,
         },
         Panel {
             title: format!("Test {id}: velocity and its peaks"),
@@ -113,15 +104,12 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
             y_label: "velocity (mm/s)".into(),
             series: vel,
             hline: None,
+            x_range: None,
         },
     ];
     plots::render(&dir.join(format!("{id}_motion")), &motion, 1000, 340)?;
     let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
-    let local: Vec<(f64, f64)> = local_ratios(&v)
-        .iter()
-        .enumerate()
-        .map(|(k, q)| ((k + 1) as f64, q / e_h))
-        .collect();
+    let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
     let ratios = [Panel {
         title: format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
         x_label: "impact".into(),
@@ -132,10 +120,8 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
             points: local,
             markers: true,
         }],
-        hline: Some((
-            r.coefficients.r,
-            format!("mean r = {:.2}", r.coefficients.r),
-        )),
+        hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
+        x_range: None,
     }];
     plots::render(&dir.join(format!("{id}_ratios")), &ratios, 800, 400)?;
     Ok(())

@@ -8,6 +8,7 @@ use std::sync::Once;
 use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+pub use plotters::style::RGBColor;
 
 use crate::atomic::write_atomic;
 
@@ -17,12 +18,7 @@ static REGISTER: Once = Once::new();
 /// Register the shipped font as "sans-serif" (once per process).
 pub fn register_font() {
     REGISTER.call_once(|| {
-        for style in [
-            FontStyle::Normal,
-            FontStyle::Bold,
-            FontStyle::Italic,
-            FontStyle::Oblique,
-        ] {
+        for style in [FontStyle::Normal, FontStyle::Bold, FontStyle::Italic, FontStyle::Oblique] {
             let _ = plotters::style::register_font("sans-serif", style, FONT);
         }
     });
@@ -48,6 +44,8 @@ pub struct Panel {
     pub y_label: String,
     pub series: Vec<Series>,
     pub hline: Option<(f64, String)>,
+    /// Fixed x range (otherwise from the data).
+    pub x_range: Option<(f64, f64)>,
 }
 
 fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
@@ -79,7 +77,10 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) 
 where
     DB::ErrorType: 'static,
 {
-    let ((x0, x1), (y0, y1)) = bounds(panel);
+    let ((mut x0, mut x1), (y0, y1)) = bounds(panel);
+    if let Some((a, b)) = panel.x_range {
+        (x0, x1) = (a, b);
+    }
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 18))
         .margin(8)
@@ -104,30 +105,23 @@ where
                 .label(s.label.as_str())
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
         } else {
+            // Thick polylines of dense series render with gaps in the bitmap
+            // backend: one pixel is enough there.
+            let width = if s.points.len() > 1500 { 1 } else { 2 };
             chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    color.stroke_width(2),
-                ))
+                .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(width)))
                 .map_err(err)?
                 .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         }
     }
     if let Some((h, label)) = &panel.hline {
         let blue = RGBColor(31, 119, 180);
         chart
-            .draw_series(LineSeries::new(
-                vec![(x0, *h), (x1, *h)],
-                blue.stroke_width(2),
-            ))
+            .draw_series(LineSeries::new(vec![(x0, *h), (x1, *h)], blue.stroke_width(2)))
             .map_err(err)?
             .label(label.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2))
-            });
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2)));
     }
     chart
         .configure_series_labels()
@@ -158,16 +152,10 @@ pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) 
     register_font();
     let size = (width, height_per_panel * panels.len() as u32);
     let mut svg = String::new();
-    draw_figure(
-        SVGBackend::with_string(&mut svg, size).into_drawing_area(),
-        panels,
-    )?;
+    draw_figure(SVGBackend::with_string(&mut svg, size).into_drawing_area(), panels)?;
     write_atomic(&stem.with_extension("svg"), svg.as_bytes())?;
     let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
-    draw_figure(
-        BitMapBackend::with_buffer(&mut buf, size).into_drawing_area(),
-        panels,
-    )?;
+    draw_figure(BitMapBackend::with_buffer(&mut buf, size).into_drawing_area(), panels)?;
     let png = encode_png(&buf, size.0, size.1)?;
     write_atomic(&stem.with_extension("png"), &png)?;
     Ok(())

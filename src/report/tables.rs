@@ -21,12 +21,7 @@ pub struct Table {
 
 type Pick = fn(&Coefficients) -> f64;
 
-fn build(
-    res: &CampaignResult,
-    name: &'static str,
-    caption: String,
-    cols: &[(&'static str, &'static str, Pick)],
-) -> Table {
+fn build(res: &CampaignResult, name: &'static str, caption: String, cols: &[(&'static str, &'static str, Pick)]) -> Table {
     let rows = res
         .tests
         .iter()
@@ -57,12 +52,7 @@ fn build(
         } else {
             format!(
                 "mean (without {})",
-                res.means
-                    .left_out
-                    .iter()
-                    .map(|(id, _)| id.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                res.means.left_out.iter().map(|(id, _)| id.as_str()).collect::<Vec<_>>().join(", ")
             )
         };
         (label, cols.iter().map(|c| (c.2)(&as_c)).collect())
@@ -82,12 +72,36 @@ pub fn tables(res: &CampaignResult) -> Vec<Table> {
     let c = &res.campaign;
     let eh = format!("e_H = {:.4} ({})", c.e_housner, c.e_housner_source);
     vec![
-        build(res, "table1", format!("Table 1: mean experimental ratios of coefficients of restitution, {} rocking (r⁺ outward, r⁻ inward); {eh}.", c.rocking.as_str()),
-            &[("r_plus", "r⁺", |q| q.r_plus), ("r_minus", "r⁻", |q| q.r_minus), ("r", "r", |q| q.r)]),
-        build(res, "table2", format!("Table 2: ratios over consecutive peaks and peaks of the same sign, and over the first two impacts; {eh}."),
-            &[("r_plus", "r⁺", |q| q.r_plus), ("r_minus", "r⁻", |q| q.r_minus), ("r", "r", |q| q.r), ("r2", "r (2 impacts)", |q| q.r2)]),
-        build(res, "table3", format!("Table 3: ratios for the first impacts (r₁⁺ outward, r₁⁻ inward); {eh}."),
-            &[("r1_plus", "r₁⁺", |q| q.r1_plus), ("r1_minus", "r₁⁻", |q| q.r1_minus), ("r1", "r₁", |q| q.r1)]),
+        build(
+            res,
+            "table1",
+            format!(
+                "Table 1: mean experimental ratios of coefficients of restitution, {} rocking (r⁺ outward, r⁻ inward); {eh}.",
+                c.rocking.as_str()
+            ),
+            &[("r_plus", "r⁺", |q| q.r_plus), ("r_minus", "r⁻", |q| q.r_minus), ("r", "r", |q| q.r)],
+        ),
+        build(
+            res,
+            "table2",
+            format!("Table 2: ratios over consecutive peaks and peaks of the same sign, and over the first two impacts; {eh}."),
+            &[
+                ("r_plus", "r⁺", |q| q.r_plus),
+                ("r_minus", "r⁻", |q| q.r_minus),
+                ("r", "r", |q| q.r),
+                ("r2", "r (2 impacts)", |q| q.r2),
+            ],
+        ),
+        build(
+            res,
+            "table3",
+            format!("Table 3: ratios for the first impacts (r₁⁺ outward, r₁⁻ inward); {eh}."),
+            &[
+                ("r1_plus", "r₁⁺", |q| q.r1_plus),
+                ("r1_minus", "r₁⁻", |q| q.r1_minus),
+                ("r1", "r₁", |q| q.r1),
+            ],
+        ),
     ]
 }
 
@@ -128,9 +142,7 @@ pub fn to_csv(t: &Table) -> anyhow::Result<Vec<u8>> {
     columns.push(Column::new("status".into(), status));
     let mut df = DataFrame::new_infer_height(columns)?;
     let mut buf = Vec::new();
-    CsvWriter::new(&mut buf)
-        .include_header(true)
-        .finish(&mut df)?;
+    CsvWriter::new(&mut buf).include_header(true).finish(&mut df)?;
     Ok(buf)
 }
 
@@ -144,22 +156,12 @@ pub fn to_markdown(t: &Table) -> String {
     let mut s = String::new();
     s.push_str(&format!(
         "| test# | {} |\n",
-        t.columns
-            .iter()
-            .map(|c| c.1)
-            .collect::<Vec<_>>()
-            .join(" | ")
+        t.columns.iter().map(|c| c.1).collect::<Vec<_>>().join(" | ")
     ));
     s.push_str(&format!("|---|{}\n", "---:|".repeat(t.columns.len())));
     for (id, vals) in &t.rows {
         match vals {
-            Ok(v) => s.push_str(&format!(
-                "| {id} | {} |\n",
-                v.iter()
-                    .map(|x| percent(*x))
-                    .collect::<Vec<_>>()
-                    .join(" | ")
-            )),
+            Ok(v) => s.push_str(&format!("| {id} | {} |\n", v.iter().map(|x| percent(*x)).collect::<Vec<_>>().join(" | "))),
             Err(e) => s.push_str(&format!(
                 "| {id} | {} |\n",
                 vec![format!("— ({})", first_words(e))]
@@ -173,10 +175,7 @@ pub fn to_markdown(t: &Table) -> String {
     if let Some((label, v)) = &t.mean {
         s.push_str(&format!(
             "| **{label}** | {} |\n",
-            v.iter()
-                .map(|x| format!("**{}**", percent(*x)))
-                .collect::<Vec<_>>()
-                .join(" | ")
+            v.iter().map(|x| format!("**{}**", percent(*x))).collect::<Vec<_>>().join(" | ")
         ));
     }
     s.push_str(&format!("\n{}\n", t.caption));

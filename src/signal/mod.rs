@@ -33,16 +33,8 @@ pub fn noise_sigma(x: &[f64]) -> f64 {
     let m = median(&d);
     let dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
     let mad = median(&dev);
-    let min_step = d
-        .iter()
-        .map(|v| v.abs())
-        .filter(|v| *v > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let floor = if min_step.is_finite() {
-        min_step / 3.0
-    } else {
-        0.0
-    };
+    let min_step = d.iter().map(|v| v.abs()).filter(|v| *v > 0.0).fold(f64::INFINITY, f64::min);
+    let floor = if min_step.is_finite() { min_step / 3.0 } else { 0.0 };
     (1.4826 * mad / std::f64::consts::SQRT_2).max(floor)
 }
 
@@ -74,10 +66,7 @@ pub fn remove_spikes(x: &mut [f64], threshold: f64) -> Vec<usize> {
 /// equations with a Cholesky factorisation (A is column-scaled first; the problems
 /// here are small and well scaled). Returns the coefficients and the residual sum
 /// of squares, or None when AᵀA is singular.
-pub fn least_squares(
-    a: &nalgebra::DMatrix<f64>,
-    y: &nalgebra::DVector<f64>,
-) -> Option<(nalgebra::DVector<f64>, f64)> {
+pub fn least_squares(a: &nalgebra::DMatrix<f64>, y: &nalgebra::DVector<f64>) -> Option<(nalgebra::DVector<f64>, f64)> {
     let ncol = a.ncols();
     let mut scale = nalgebra::DVector::zeros(ncol);
     for j in 0..ncol {

@@ -22,14 +22,10 @@ impl SavGol {
     /// `window` odd and ≥ 3, `order` < `window`.
     pub fn new(window: usize, order: usize) -> Result<SavGol, String> {
         if window < 3 || window % 2 == 0 {
-            return Err(format!(
-                "Savitzky–Golay window {window}: expected an odd number ≥ 3"
-            ));
+            return Err(format!("Savitzky–Golay window {window}: expected an odd number ≥ 3"));
         }
         if order >= window {
-            return Err(format!(
-                "Savitzky–Golay order {order}: expected an order below the window ({window})"
-            ));
+            return Err(format!("Savitzky–Golay order {order}: expected an order below the window ({window})"));
         }
         Ok(SavGol {
             half_window: window / 2,
@@ -51,20 +47,11 @@ impl SavGol {
     fn derivative_weights(&self, at: f64) -> Vec<f64> {
         let m = self.half_window as i64;
         let w = self.window();
-        let a = DMatrix::from_fn(w, self.order + 1, |i, j| {
-            ((i as i64 - m) as f64).powi(j as i32)
-        });
-        let pinv = a
-            .clone()
-            .pseudo_inverse(1e-12)
-            .expect("Vandermonde pseudo-inverse");
+        let a = DMatrix::from_fn(w, self.order + 1, |i, j| ((i as i64 - m) as f64).powi(j as i32));
+        let pinv = a.clone().pseudo_inverse(1e-12).expect("Vandermonde pseudo-inverse");
         // d/dx Σ c_j x^j at x = at  →  Σ j c_j at^{j-1}
         (0..w)
-            .map(|col| {
-                (1..=self.order)
-                    .map(|j| j as f64 * at.powi(j as i32 - 1) * pinv[(j, col)])
-                    .sum()
-            })
+            .map(|col| (1..=self.order).map(|j| j as f64 * at.powi(j as i32 - 1) * pinv[(j, col)]).sum())
             .collect()
     }
 
@@ -80,11 +67,7 @@ impl SavGol {
         let centre = self.derivative_weights(0.0);
         let mut out = vec![0.0; n];
         for i in m..n - m {
-            let s: f64 = centre
-                .iter()
-                .zip(&x[i - m..i + m + 1])
-                .map(|(c, v)| c * v)
-                .sum();
+            let s: f64 = centre.iter().zip(&x[i - m..i + m + 1]).map(|(c, v)| c * v).sum();
             out[i] = s / dt;
         }
         for i in 0..m {
@@ -92,12 +75,7 @@ impl SavGol {
             out[i] = head.iter().zip(&x[..w]).map(|(c, v)| c * v).sum::<f64>() / dt;
             let tail = self.derivative_weights(m as f64 - i as f64);
             let j = n - 1 - i;
-            out[j] = tail
-                .iter()
-                .zip(&x[n - w..])
-                .map(|(c, v)| c * v)
-                .sum::<f64>()
-                / dt;
+            out[j] = tail.iter().zip(&x[n - w..]).map(|(c, v)| c * v).sum::<f64>() / dt;
         }
         out
     }

@@ -18,12 +18,7 @@ pub struct Block {
 impl Block {
     /// Rectangular block of height h, thickness b, width w and unit weight γ
     /// (kN/m³): R = ½√(h² + b²), α = atan(b/h), m = γ h b w / g, I_0 = 4/3 m R².
-    pub fn rectangular(
-        height_m: f64,
-        thickness_m: f64,
-        width_m: f64,
-        unit_weight_kn_m3: f64,
-    ) -> Block {
+    pub fn rectangular(height_m: f64, thickness_m: f64, width_m: f64, unit_weight_kn_m3: f64) -> Block {
         let r = 0.5 * height_m.hypot(thickness_m);
         let mass = unit_weight_kn_m3 * 1e3 * height_m * thickness_m * width_m / G;
         Block {

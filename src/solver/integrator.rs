@@ -95,55 +95,16 @@ pub struct Tolerances {
 }
 
 /// One Dormand–Prince step of size h from (t, y) with k1 = f(t, y).
-pub fn step(
-    f: &mut impl FnMut(f64, &State) -> State,
-    t: f64,
-    y: &State,
-    k1: &State,
-    h: f64,
-    tol: Tolerances,
-) -> Step {
+pub fn step(f: &mut impl FnMut(f64, &State) -> State, t: f64, y: &State, k1: &State, h: f64, tol: Tolerances) -> Step {
     let k2 = f(t + C2 * h, &axpy(y, &[(h * A21, k1)]));
     let k3 = f(t + C3 * h, &axpy(y, &[(h * A31, k1), (h * A32, &k2)]));
-    let k4 = f(
-        t + C4 * h,
-        &axpy(y, &[(h * A41, k1), (h * A42, &k2), (h * A43, &k3)]),
-    );
-    let k5 = f(
-        t + C5 * h,
-        &axpy(
-            y,
-            &[
-                (h * A51, k1),
-                (h * A52, &k2),
-                (h * A53, &k3),
-                (h * A54, &k4),
-            ],
-        ),
-    );
+    let k4 = f(t + C4 * h, &axpy(y, &[(h * A41, k1), (h * A42, &k2), (h * A43, &k3)]));
+    let k5 = f(t + C5 * h, &axpy(y, &[(h * A51, k1), (h * A52, &k2), (h * A53, &k3), (h * A54, &k4)]));
     let k6 = f(
         t + h,
-        &axpy(
-            y,
-            &[
-                (h * A61, k1),
-                (h * A62, &k2),
-                (h * A63, &k3),
-                (h * A64, &k4),
-                (h * A65, &k5),
-            ],
-        ),
+        &axpy(y, &[(h * A61, k1), (h * A62, &k2), (h * A63, &k3), (h * A64, &k4), (h * A65, &k5)]),
     );
-    let y1 = axpy(
-        y,
-        &[
-            (h * A71, k1),
-            (h * A73, &k3),
-            (h * A74, &k4),
-            (h * A75, &k5),
-            (h * A76, &k6),
-        ],
-    );
+    let y1 = axpy(y, &[(h * A71, k1), (h * A73, &k3), (h * A74, &k4), (h * A75, &k5), (h * A76, &k6)]);
     let k7 = f(t + h, &y1);
     let mut err2 = 0.0;
     let mut r = [[0.0; 2]; 5];
@@ -169,11 +130,7 @@ pub fn step(
 
 /// Next step size from the error norm (safety 0.9, growth in [0.2, 5]).
 pub fn next_h(h: f64, err: f64) -> f64 {
-    let fac = if err == 0.0 {
-        5.0
-    } else {
-        (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
-    };
+    let fac = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
     h * fac
 }
 
@@ -228,10 +185,7 @@ mod tests {
     /// and the dense output matches the exact solution inside steps.
     #[test]
     fn harmonic_oscillator_and_dense_output() {
-        let tol = Tolerances {
-            rtol: 1e-10,
-            atol: 1e-12,
-        };
+        let tol = Tolerances { rtol: 1e-10, atol: 1e-12 };
         let mut f = |_t: f64, y: &State| [y[1], -y[0]];
         let (mut t, mut y) = (0.0, [1.0, 0.0]);
         let mut k1 = f(t, &y);

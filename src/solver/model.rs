@@ -71,6 +71,18 @@ impl Ground {
             (i as usize).min(self.acc.len().saturating_sub(2))
         }
     }
+    /// The linear piece of ü_g that holds just after t: (t, ü_g(t), slope), zero
+    /// outside the record.
+    pub fn linear_piece(&self, t: f64) -> (f64, f64, f64) {
+        if self.acc.len() < 2 || t < self.t0 || t >= self.end() {
+            return (t, 0.0, 0.0);
+        }
+        let i = ((t - self.t0) / self.dt * (1.0 + 1e-12) + 1e-9).floor() as usize;
+        let i = i.min(self.acc.len() - 2);
+        let slope = (self.acc[i + 1] - self.acc[i]) / self.dt;
+        (t, self.at(t), slope)
+    }
+
     /// ü_g at t, linear between samples, zero outside the record.
     pub fn at(&self, t: f64) -> f64 {
         if self.acc.len() < 2 || t < self.t0 || t > self.end() {
@@ -105,11 +117,7 @@ impl RockingModel {
     #[inline]
     pub fn accel(&self, s: f64, theta: f64, a: f64, plastic: &[f64]) -> f64 {
         let x = self.alpha - s * theta;
-        let (sn, cs) = if self.linearized {
-            (x, 1.0)
-        } else {
-            x.sin_cos()
-        };
+        let (sn, cs) = if self.linearized { (x, 1.0) } else { x.sin_cos() };
         let mut acc = -self.p2 * s * sn + self.p2 / G * a * cs;
         if theta < 0.0 {
             if let Restraint::Rotational { k_nm_per_rad } = self.restraint {

@@ -23,10 +23,7 @@ pub struct Settings {
 impl Settings {
     pub fn new(t_end: f64) -> Settings {
         Settings {
-            tol: Tolerances {
-                rtol: 1e-9,
-                atol: 1e-12,
-            },
+            tol: Tolerances { rtol: 1e-9, atol: 1e-12 },
             t_end,
             rest_speed: 1e-7,
             max_step: 0.01,
@@ -107,13 +104,7 @@ enum Phase {
 }
 
 /// Run the model from `t0`, at rest unless `initial` = (θ0, θ0') is given.
-pub fn simulate(
-    model: &RockingModel,
-    ground: &Ground,
-    t0: f64,
-    initial: Option<State>,
-    settings: &Settings,
-) -> Simulation {
+pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings) -> Simulation {
     let mut sim = Simulation {
         stop: Stop::End,
         events: Vec::new(),
@@ -127,9 +118,7 @@ pub fn simulate(
     let mut t = t0;
     let mut y: State = initial.unwrap_or([0.0, 0.0]);
     let mut phase = match initial {
-        Some([th, om]) if th != 0.0 || om != 0.0 => {
-            Phase::Rocking(if th != 0.0 { th.signum() } else { om.signum() })
-        }
+        Some([th, om]) if th != 0.0 || om != 0.0 => Phase::Rocking(if th != 0.0 { th.signum() } else { om.signum() }),
         _ => Phase::Rest,
     };
     let thr = model.uplift_threshold();
@@ -157,10 +146,7 @@ pub fn simulate(
                             push(&mut sim, tu, &y);
                         }
                         t = tu;
-                        sim.events.push(Event::Uplift {
-                            t,
-                            side: side as i8,
-                        });
+                        sim.events.push(Event::Uplift { t, side: side as i8 });
                         phase = Phase::Rocking(side);
                     }
                     None => {
@@ -174,9 +160,9 @@ pub fn simulate(
                 let mut k1: State = [y[1], model.accel(s, y[0], ground.at(t), &plastic)];
                 loop {
                     let pl = &plastic;
-                    let mut f = |tt: f64, yy: &State| -> State {
-                        [yy[1], model.accel(s, yy[0], ground.at(tt), pl)]
-                    };
+                    // The step never crosses a record sample, so ü_g is linear on it.
+                    let (ta, a0, slope) = ground.linear_piece(t);
+                    let mut f = |tt: f64, yy: &State| -> State { [yy[1], model.accel(s, yy[0], a0 + slope * (tt - ta), pl)] };
                     let boundary = next_sample_after(ground, t).min(settings.t_end);
                     let hh = h.min(boundary - t).min(settings.max_step);
                     if hh <= 1e-14 * t.abs().max(1.0) {
@@ -225,11 +211,7 @@ pub fn simulate(
                             let ye = st.dense.at(te);
                             let vb = ye[1];
                             let entering = -s;
-                            let e = if entering < 0.0 {
-                                model.e_in
-                            } else {
-                                model.e_out
-                            };
+                            let e = if entering < 0.0 { model.e_in } else { model.e_out };
                             let va = e * vb;
                             push(&mut sim, te, &[0.0, vb]);
                             sim.impacts += 1;
@@ -271,15 +253,19 @@ enum EventKind {
 /// The first event inside an accepted step: θ returning to 0 from side s, or θ
 /// reaching the overturning level. The dense output is sampled at 8 points so
 /// that a short excursion inside one step is not missed.
-fn first_event(
-    model: &RockingModel,
-    s: f64,
-    d: &Dense,
-    t: f64,
-    h: f64,
-    y0: &State,
-) -> Option<(f64, EventKind)> {
+fn first_event(model: &RockingModel, s: f64, d: &Dense, t: f64, h: f64, y0: &State) -> Option<(f64, EventKind)> {
     let level = model.overturn_level(s);
+    // Quick exclusion: on the step θ stays within h·(|ω₀| + |ω₁|) + h²·(|θ''|max)
+    // of its end values (Taylor bound; |θ''| taken generously from the change of ω
+    // across the step plus p²), so a step far from 0 and from the limit holds no event.
+    let y1 = d.at(t + h);
+    let acc = (y1[1] - y0[1]).abs() / h;
+    let reach = h * (y0[1].abs() + y1[1].abs()) + h * h * (2.0 * acc + 2.0 * model.p2);
+    let near_zero = s * y0[0] <= reach || s * y1[0] <= reach;
+    let near_limit = level.is_some_and(|lv| (lv - y0[0]).abs() <= reach || (lv - y1[0]).abs() <= reach);
+    if !near_zero && !near_limit {
+        return None;
+    }
     let n = 8;
     let mut prev_t = t;
     let mut prev = *y0;

@@ -1,0 +1,229 @@
+//! `rocklab simulate --block BLOCK.toml --record FILE … --out DIR`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use clap::{Args, ValueEnum};
+use serde_json::json;
+
+use super::say;
+use rocklab::atomic::write_atomic;
+use rocklab::ground_motion::{self, Format, ReadOptions, Units};
+use rocklab::ingest::block::BlockSpec;
+use rocklab::report::plots::{self, Panel, Series};
+use rocklab::study::{run, RunSpec};
+
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormatArg {
+    Auto,
+    Esm,
+    At2,
+    Cosmos,
+    TwoColumn,
+    OneColumn,
+}
+
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// Block file (TOML, see README).
+    #[arg(long)]
+    pub block: PathBuf,
+    /// Ground-motion record.
+    #[arg(long)]
+    pub record: PathBuf,
+    #[arg(long, value_enum, default_value_t = FormatArg::Auto)]
+    pub format: FormatArg,
+    /// Time step (s) of a one-column record.
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Units of the record: g, m/s2 or cm/s2 (read from the header when it has one).
+    #[arg(long)]
+    pub units: Option<String>,
+    /// Scale factor (magnification; the paper uses 1.27).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Polarity of the record: 1 or -1.
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    pub polarity: i32,
+    /// One coefficient of restitution for both sides.
+    #[arg(long, conflicts_with_all = ["e_in", "e_out"])]
+    pub e: Option<f64>,
+    /// Coefficient when entering the inward side.
+    #[arg(long, requires = "e_out")]
+    pub e_in: Option<f64>,
+    /// Coefficient when entering the outward side.
+    #[arg(long, requires = "e_in")]
+    pub e_out: Option<f64>,
+    /// Overturning limit (rad); default α.
+    #[arg(long)]
+    pub overturn_limit: Option<f64>,
+    /// Seconds simulated after the end of the record.
+    #[arg(long, default_value_t = 0.0)]
+    pub t_extra: f64,
+    /// Relative tolerance of the integrator.
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    /// Absolute tolerance of the integrator (rad, rad/s).
+    #[arg(long, default_value_t = 1e-10)]
+    pub atol: f64,
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+pub fn read_options(format: FormatArg, dt: Option<f64>, units: Option<&str>) -> anyhow::Result<ReadOptions> {
+    let format = match format {
+        FormatArg::Auto => None,
+        FormatArg::Esm => Some(Format::Esm),
+        FormatArg::At2 => Some(Format::At2),
+        FormatArg::Cosmos => Some(Format::Cosmos),
+        FormatArg::TwoColumn => Some(Format::TwoColumn),
+        FormatArg::OneColumn => Some(Format::OneColumn),
+    };
+    let units = units
+        .map(|u| Units::parse(u).ok_or_else(|| anyhow::anyhow!("--units {u}: expected g, m/s2 or cm/s2")))
+        .transpose()?;
+    Ok(ReadOptions { format, dt, units })
+}
+
+fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
+    if e > 0.0 && e <= 1.0 {
+        Ok(e)
+    } else {
+        bail!("{name} = {e}: expected 0 < e ≤ 1")
+    }
+}
+
+pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
+    let block = BlockSpec::load(&a.block)?;
+    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let (e_in, e_out) = match (a.e, a.e_in, a.e_out, block.impact) {
+        (Some(e), ..) => (e, e),
+        (None, Some(i), Some(o), _) => (i, o),
+        (None, None, None, d) => match (d.e, d.e_in, d.e_out) {
+            (Some(e), _, _) => (e, e),
+            (None, Some(i), Some(o)) => (i, o),
+            _ => bail!("no coefficient of restitution: pass --e E or --e-in X --e-out Y (or set [impact] in the block file)"),
+        },
+        _ => bail!("pass --e E, or both --e-in and --e-out"),
+    };
+    let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
+    if a.polarity != 1 && a.polarity != -1 {
+        bail!("--polarity {}: expected 1 or -1", a.polarity);
+    }
+    if !(a.scale.is_finite() && a.scale > 0.0) {
+        bail!("--scale {}: expected a positive number", a.scale);
+    }
+    let limit = a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha);
+    let spec = RunSpec {
+        e_in,
+        e_out,
+        scale: a.scale,
+        polarity: a.polarity as f64,
+        overturn_limit: limit,
+        t_extra: a.t_extra,
+        rtol: a.rtol,
+        atol: a.atol,
+        keep_history: true,
+    };
+    let (summary, sim) = run(&block, &record, &spec);
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let alpha = block.block.alpha;
+    let doc = json!({
+        "block": block.name,
+        "record": a.record.display().to_string(),
+        "record_notes": record.notes,
+        "alpha_rad": alpha, "p2_per_s2": block.block.p2(), "i0_kg_m2": block.block.i0, "mass_kg": block.block.mass_kg, "r_m": block.block.r_m,
+        "e_in": e_in, "e_out": e_out, "scale": a.scale, "polarity": a.polarity, "overturn_limit_rad": limit,
+        "rtol": a.rtol, "atol": a.atol,
+        "max_theta_over_alpha": summary.max_theta_over_alpha,
+        "min_theta_over_alpha": summary.min_theta_over_alpha,
+        "overturned": summary.overturned,
+        "overturn_time_s": summary.overturn_time_s,
+        "impacts": summary.impacts,
+        "pga_g": summary.pga_g,
+        "pgv_cm_s": summary.pgv_cm_s,
+        "solve_wall_s": summary.solve_wall_s,
+        "steps": summary.steps,
+        "events": sim.events,
+    });
+    write_atomic(&a.out.join("summary.json"), &serde_json::to_vec_pretty(&doc)?)?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["t_s", "theta_rad", "theta_over_alpha", "theta_dot_rad_s", "ag_m_s2"])?;
+    for s in &sim.history {
+        w.write_record([s.t, s.theta, s.theta / alpha, s.omega, s.ag].iter().map(|v| v.to_string()))?;
+    }
+    write_atomic(&a.out.join("history.csv"), &w.into_inner()?)?;
+    let panels = response_panels(
+        &block.name,
+        &[("response", &sim.history, plots::RED)],
+        alpha,
+        &record_points(&record, &spec),
+    );
+    plots::render(&a.out.join("response"), &panels, 1000, 320)?;
+    say(&format!(
+        "{}: max θ/α = {:.3}, min θ/α = {:.3}, {}, {} impacts, PGA {:.3} g, PGV {:.2} cm/s, solved in {:.2} ms",
+        block.name,
+        summary.max_theta_over_alpha,
+        summary.min_theta_over_alpha,
+        match summary.overturn_time_s {
+            Some(t) => format!("OVERTURNED at {t:.3} s"),
+            None => "stands".into(),
+        },
+        summary.impacts,
+        summary.pga_g,
+        summary.pgv_cm_s,
+        summary.solve_wall_s * 1e3
+    ));
+    say(&format!("wrote {}", a.out.display()));
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The scaled ground acceleration in g for plots.
+pub fn record_points(record: &ground_motion::Record, spec: &RunSpec) -> Vec<(f64, f64)> {
+    let k = spec.scale * spec.polarity / rocklab::G;
+    record
+        .acc_m_s2
+        .iter()
+        .enumerate()
+        .map(|(i, a)| (record.t0 + i as f64 * record.dt, a * k))
+        .collect()
+}
+
+/// Paper Fig. 8/9 style: θ/α of one or more runs over time, then the scaled ground
+/// acceleration.
+pub fn response_panels(title: &str, runs: &[(&str, &[rocklab::solver::run::Sample], plots::RGBColor)], alpha: f64, ag: &[(f64, f64)]) -> Vec<Panel> {
+    let span = ag.first().zip(ag.last()).map(|(a, b)| (a.0, b.0));
+    let series = runs
+        .iter()
+        .map(|(label, h, color)| Series {
+            label: label.to_string(),
+            color: *color,
+            points: h.iter().map(|s| (s.t, s.theta / alpha)).collect(),
+            markers: false,
+        })
+        .collect();
+    vec![
+        Panel {
+            title: format!("{title}: normalised rotation"),
+            x_label: "time (s)".into(),
+            y_label: "θ/α".into(),
+            series,
+            hline: None,
+            x_range: span,
+        },
+        Panel {
+            title: "ground acceleration (scaled)".into(),
+            x_label: "time (s)".into(),
+            y_label: "ü_g (g)".into(),
+            series: vec![Series {
+                label: "ü_g".into(),
+                color: plots::BLACKISH,
+                points: ag.to_vec(),
+                markers: false,
+            }],
+            hline: None,
+            x_range: span,
+        },
+    ]
+}

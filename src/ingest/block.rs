@@ -1,0 +1,217 @@
+//! BLOCK.toml: a rocking wall for the solver. Documented in the README.
+//!
+//! ```toml
+//! [block]
+//! name = "façade"
+//! height_m = 7.64          # rectangular geometry…
+//! thickness_m = 0.80
+//! width_m = 12.00
+//! unit_weight_kn_m3 = 18.0
+//! r_m = 3.84               # …and optional overrides of R, α, I_0, mass
+//! alpha_rad = 0.10
+//! # i0_kg_m2 = 2.6e6
+//! # mass_kg = 1.3e5
+//! [restraint]              # optional: transverse walls, acting for θ < 0
+//! unit_stiffness_mn_m2 = 750.0   # K'_c (MN/m per m of height)
+//! contact_height_m = 7.64
+//! # rotational_stiffness_mnm_rad = 1.1e5   # or k_θ directly
+//! [[tie_rod]]              # optional, any number
+//! stiffness_kn_m = 20000.0
+//! height_m = 7.0
+//! yield_force_kn = 150.0   # optional: elastic–perfectly-plastic
+//! [impact]                 # optional defaults for simulate
+//! e_in = 0.59
+//! e_out = 0.68
+//! overturn_limit_rad = 0.10
+//! ```
+
+use std::path::Path;
+
+use serde::Deserialize;
+
+use crate::solver::{Block, Restraint, TieRod};
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    block: RawBlock,
+    restraint: Option<RawRestraint>,
+    #[serde(default)]
+    tie_rod: Vec<RawTie>,
+    impact: Option<RawImpact>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBlock {
+    name: Option<String>,
+    height_m: f64,
+    thickness_m: f64,
+    width_m: f64,
+    unit_weight_kn_m3: f64,
+    r_m: Option<f64>,
+    alpha_rad: Option<f64>,
+    i0_kg_m2: Option<f64>,
+    mass_kg: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRestraint {
+    unit_stiffness_mn_m2: Option<f64>,
+    contact_height_m: Option<f64>,
+    rotational_stiffness_mnm_rad: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTie {
+    stiffness_kn_m: f64,
+    height_m: f64,
+    yield_force_kn: Option<f64>,
+}
+
+/// Optional impact defaults of a block file.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactDefaults {
+    pub e: Option<f64>,
+    pub e_in: Option<f64>,
+    pub e_out: Option<f64>,
+    pub overturn_limit_rad: Option<f64>,
+}
+
+type RawImpact = ImpactDefaults;
+
+/// A validated block file.
+#[derive(Debug, Clone)]
+pub struct BlockSpec {
+    pub name: String,
+    pub block: Block,
+    pub restraint: Restraint,
+    pub ties: Vec<TieRod>,
+    pub impact: ImpactDefaults,
+    /// Which of R, α, I_0, mass were overridden.
+    pub overrides: Vec<String>,
+}
+
+fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(anyhow::anyhow!("{}: {key} = {v}: expected a positive number", path.display()))
+    }
+}
+
+impl BlockSpec {
+    pub fn load(path: &Path) -> anyhow::Result<BlockSpec> {
+        let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: cannot read block file: {e}", path.display()))?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> anyhow::Result<BlockSpec> {
+        let raw: RawFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let b = &raw.block;
+        let mut block = Block::rectangular(
+            positive(path, "[block].height_m", b.height_m)?,
+            positive(path, "[block].thickness_m", b.thickness_m)?,
+            positive(path, "[block].width_m", b.width_m)?,
+            positive(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3)?,
+        );
+        let mut overrides = Vec::new();
+        if let Some(m) = b.mass_kg {
+            block.mass_kg = positive(path, "[block].mass_kg", m)?;
+            overrides.push("mass_kg".into());
+        }
+        if let Some(r) = b.r_m {
+            block.r_m = positive(path, "[block].r_m", r)?;
+            overrides.push("r_m".into());
+        }
+        if let Some(a) = b.alpha_rad {
+            if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+                anyhow::bail!("{}: [block].alpha_rad = {a}: expected 0 < α < π/2", path.display());
+            }
+            block.alpha = a;
+            overrides.push("alpha_rad".into());
+        }
+        // I_0 = 4/3 m R² with the final m and R unless given.
+        block.i0 = match b.i0_kg_m2 {
+            Some(i) => {
+                overrides.push("i0_kg_m2".into());
+                positive(path, "[block].i0_kg_m2", i)?
+            }
+            None => 4.0 / 3.0 * block.mass_kg * block.r_m * block.r_m,
+        };
+        let restraint = match &raw.restraint {
+            None => Restraint::None,
+            Some(r) => match (r.unit_stiffness_mn_m2, r.contact_height_m, r.rotational_stiffness_mnm_rad) {
+                (Some(k), Some(h), None) => {
+                    Restraint::spring_bed(positive(path, "unit_stiffness_mn_m2", k)? * 1e6, positive(path, "contact_height_m", h)?)
+                }
+                (None, None, Some(k)) => Restraint::Rotational {
+                    k_nm_per_rad: positive(path, "rotational_stiffness_mnm_rad", k)? * 1e6,
+                },
+                _ => anyhow::bail!(
+                    "{}: [restraint]: give unit_stiffness_mn_m2 with contact_height_m, or rotational_stiffness_mnm_rad alone",
+                    path.display()
+                ),
+            },
+        };
+        let ties = raw
+            .tie_rod
+            .iter()
+            .map(|t| {
+                Ok(TieRod {
+                    stiffness_n_m: positive(path, "[[tie_rod]].stiffness_kn_m", t.stiffness_kn_m)? * 1e3,
+                    height_m: positive(path, "[[tie_rod]].height_m", t.height_m)?,
+                    yield_force_n: t
+                        .yield_force_kn
+                        .map(|f| positive(path, "[[tie_rod]].yield_force_kn", f).map(|v| v * 1e3))
+                        .transpose()?,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(BlockSpec {
+            name: b
+                .name
+                .clone()
+                .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),
+            block,
+            restraint,
+            ties,
+            impact: raw.impact.unwrap_or_default(),
+            overrides,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn facade_fixture() {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml");
+        let b = BlockSpec::load(&p).unwrap();
+        assert_eq!(b.block.r_m, 3.84);
+        assert_eq!(b.block.alpha, 0.10);
+        // m = 18 kN/m³ · 7.64 · 0.80 · 12.00 m³ / g
+        let m = 18e3 * 7.64 * 0.80 * 12.0 / crate::G;
+        assert!((b.block.mass_kg / m - 1.0).abs() < 1e-12);
+        assert!((b.block.i0 / (4.0 / 3.0 * m * 3.84 * 3.84) - 1.0).abs() < 1e-12);
+        match b.restraint {
+            Restraint::Rotational { k_nm_per_rad } => assert!((k_nm_per_rad / (750e6 * 7.64f64.powi(3) / 3.0) - 1.0).abs() < 1e-12),
+            _ => panic!("spring bed expected"),
+        }
+    }
+
+    #[test]
+    fn unknown_key_rejected() {
+        let e = BlockSpec::parse(
+            "[block]\nheight_m=1\nthickness_m=0.1\nwidth_m=1\nunit_weight_kn_m3=18\nhieght=2\n",
+            Path::new("b.toml"),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("hieght"), "{e}");
+    }
+}

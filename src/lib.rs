@@ -11,6 +11,7 @@
 
 pub mod atomic;
 pub mod error;
+pub mod facade;
 pub mod ground_motion;
 pub mod ingest;
 pub mod peaks;

@@ -363,3 +363,105 @@ fn simulate_needs_a_coefficient_and_reports_bad_records() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("bad.txt:3"), "{err}");
 }
+
+fn write_study(dir: &Path, body: &str) -> PathBuf {
+    let block = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml");
+    let pulse = gm_dir().join("synthetic/one_sine_pulse.csv");
+    let text = body
+        .replace("BLOCK", &block.display().to_string())
+        .replace("PULSE", &pulse.display().to_string());
+    let p = dir.join("study.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const SMALL_STUDY: &str = r#"
+[study]
+block = "BLOCK"
+magnification = 1.0
+polarities = [1]
+
+[[record]]
+name = "pulse"
+file = "PULSE"
+units = "g"
+
+[[coefficients]]
+name = "housner"
+housner = "eq2"
+
+[[coefficients]]
+name = "calibrated"
+e_in = 0.59
+e_out = 0.68
+"#;
+
+fn facade(study: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .arg("facade")
+        .arg(study)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// Issue #5: a small study end to end, with an IDA.
+#[test]
+fn facade_small_study_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = write_study(dir.path(), SMALL_STUDY);
+    let out = dir.path().join("out");
+    let o = facade(&study, &out, &["--scales", "0.5:1.5:3"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = s["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for r in runs {
+        for k in [
+            "record",
+            "coefficients",
+            "polarity",
+            "pga_g",
+            "pgv_cm_s",
+            "max_theta_over_alpha",
+            "min_theta_over_alpha",
+            "overturned",
+            "overturn_time_s",
+            "well_conditioned",
+        ] {
+            assert!(r.get(k).is_some(), "missing {k}");
+        }
+        assert!((r["pga_g"].as_f64().unwrap() - 0.6).abs() < 1e-9);
+    }
+    assert!((s["e_housner_eq2"].as_f64().unwrap() - (1.0 - 1.5 * 0.1f64.sin().powi(2))).abs() < 1e-12);
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("ratio_calibrated_over_housner"));
+    assert_eq!(std::fs::read_to_string(out.join("ida.csv")).unwrap().lines().count(), 1 + 3 * 2);
+    assert_eq!(std::fs::read_to_string(out.join("ida_fraction.csv")).unwrap().lines().count(), 1 + 3 * 2);
+    for f in ["response_pulse.png", "ida_housner.svg", "ida_fraction.png", "results.md"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
+
+/// Issue #5: the study parser's errors name what is wrong.
+#[test]
+fn facade_study_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &str); 4] = [
+        (&SMALL_STUDY.replace("PULSE", "/nonexistent/rec.csv"), "not found"),
+        (&SMALL_STUDY.replace("housner = \"eq2\"", "housner = \"eq7\""), "expected \"eq2\""),
+        (&SMALL_STUDY.replace("e_in = 0.59", "e_inn = 0.59"), "e_inn"),
+        (&SMALL_STUDY.replace("polarities = [1]", "polarities = [2]"), "polarities"),
+    ];
+    for (body, expect) in cases {
+        let study = write_study(dir.path(), body);
+        let o = facade(&study, &dir.path().join("o"), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
+    }
+    let study = write_study(dir.path(), SMALL_STUDY);
+    let o = facade(&study, &dir.path().join("o"), &["--scales", "2:1:10"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("FROM:TO:N"));
+}

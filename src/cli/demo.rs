@@ -16,5 +16,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         ok &= res.failed().next().is_none();
         say("");
     }
+    let study = rocklab::facade::Study::load(&args.fixtures.join("facade/study.toml"))?;
+    say(&format!("façade study: {}", study.name));
+    let out = args.out.join("facade");
+    std::fs::create_dir_all(&out)?;
+    super::facade::study_outputs(&study, &out)?;
+    say(&format!("wrote {}", out.display()));
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

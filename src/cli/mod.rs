@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 mod demo;
+mod facade;
 mod reduce;
 mod simulate;
 
@@ -27,6 +28,8 @@ enum Command {
     Reduce(ReduceArgs),
     /// Rocking response of a block to a ground-motion record (paper Eq. 1).
     Simulate(simulate::SimulateArgs),
+    /// Façade study: coefficient sets × records × polarities (and scales).
+    Facade(facade::FacadeArgs),
     /// Reduce the fixture campaigns shipped in `fixtures/` into `reports/demo/`.
     Demo(DemoArgs),
 }
@@ -81,6 +84,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Reduce(a) => reduce::run(a),
         Command::Simulate(a) => simulate::run_cli(a),
+        Command::Facade(a) => facade::run(a),
         Command::Demo(a) => demo::run(a),
     }
 }

@@ -10,8 +10,10 @@
 //! [`solver`], [`wall`]) touches no files; the edges ([`ingest`], [`report`], `cli`) depend on it, never the reverse.
 
 pub mod atomic;
+pub mod calibrate;
 pub mod error;
 pub mod facade;
+pub mod fit;
 pub mod ground_motion;
 pub mod ingest;
 pub mod peaks;

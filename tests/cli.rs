@@ -465,3 +465,50 @@ fn facade_study_errors() {
     let o = facade(&study, &dir.path().join("o"), &["--scales", "2:1:10"]);
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("FROM:TO:N"));
 }
+
+/// Issue #4: `calibrate` writes calibration.toml and summary.json["calibration"];
+/// the file round-trips into `simulate --calibration`.
+#[test]
+fn calibrate_then_simulate_with_the_calibration() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cal");
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .arg("calibrate")
+        .arg(fixtures().join("two-sided-demo/campaign.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let c = &s["calibration"];
+    for k in ["e_in", "e_out", "r_in", "r_out"] {
+        assert!(c[k].as_f64().is_some(), "{k}");
+    }
+    let tests = c["tests"].as_array().unwrap();
+    assert_eq!(tests.len(), 5);
+    for t in tests {
+        for k in ["id", "e_in", "e_out", "rms_mm"] {
+            assert!(t.get(k).is_some(), "{k}");
+        }
+        // Two-sided: one e for both sides.
+        assert_eq!(t["e_in"], t["e_out"]);
+    }
+    assert!(out.join("plots/coefficients.png").is_file());
+    let sim = dir.path().join("sim");
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .args(["simulate", "--block"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml"))
+        .arg("--record")
+        .arg(gm_dir().join("esm-central-italy-2016/IT.NRC..HGE.D.20160824.013632.C.ACC.ASC"))
+        .arg("--calibration")
+        .arg(out.join("calibration.toml"))
+        .arg("--out")
+        .arg(&sim)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: Value = serde_json::from_str(&std::fs::read_to_string(sim.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(r["e_in"], c["e_in"]);
+    assert_eq!(r["e_out"], c["e_out"]);
+}

@@ -14,6 +14,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_and_write(campaign, PeakOptions::default(), &args.out.join(name), true)?;
         ok &= res.failed().next().is_none();
+        let cal = super::calibrate::calibrate_and_write(&res, &args.out.join(name).join("calibration"), 6)?;
+        ok &= cal.failed.is_empty();
         say("");
     }
     let study = rocklab::facade::Study::load(&args.fixtures.join("facade/study.toml"))?;

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod calibrate;
 mod demo;
 mod facade;
 mod reduce;
@@ -26,6 +27,8 @@ struct Cli {
 enum Command {
     /// Reduce a free-vibration campaign: peaks, Eq. 3/4 coefficients, Tables 1–3, plots.
     Reduce(ReduceArgs),
+    /// Fit e_in/e_out by replaying each test with the solver.
+    Calibrate(calibrate::CalibrateArgs),
     /// Rocking response of a block to a ground-motion record (paper Eq. 1).
     Simulate(simulate::SimulateArgs),
     /// Façade study: coefficient sets × records × polarities (and scales).
@@ -85,6 +88,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Reduce(a) => reduce::run(a),
         Command::Simulate(a) => simulate::run_cli(a),
         Command::Facade(a) => facade::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => demo::run(a),
     }
 }

@@ -55,6 +55,9 @@ pub struct SimulateArgs {
     /// Coefficient when entering the outward side.
     #[arg(long, requires = "e_in")]
     pub e_out: Option<f64>,
+    /// calibration.toml written by `rocklab calibrate` (its e_in and e_out).
+    #[arg(long, conflicts_with_all = ["e", "e_in", "e_out"])]
+    pub calibration: Option<PathBuf>,
     /// Overturning limit (rad); default α.
     #[arg(long)]
     pub overturn_limit: Option<f64>,
@@ -97,7 +100,9 @@ fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
 pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     let block = BlockSpec::load(&a.block)?;
     let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let from_file = a.calibration.as_deref().map(rocklab::facade::read_calibration).transpose()?;
     let (e_in, e_out) = match (a.e, a.e_in, a.e_out, block.impact) {
+        _ if from_file.is_some() => from_file.unwrap_or_default(),
         (Some(e), ..) => (e, e),
         (None, Some(i), Some(o), _) => (i, o),
         (None, None, None, d) => match (d.e, d.e_in, d.e_out) {

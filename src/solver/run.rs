@@ -103,8 +103,56 @@ enum Phase {
     Rocking(f64),
 }
 
+/// θ at requested output times, filled as the run advances (dense output inside
+/// steps, 0 at rest, the last value after the run stops).
+struct Outputs<'a> {
+    times: &'a [f64],
+    values: Vec<f64>,
+}
+
+impl Outputs<'_> {
+    /// Fill every requested time < `upto` with `f(t)`.
+    fn fill(&mut self, upto: f64, f: impl Fn(f64) -> f64) {
+        while self.values.len() < self.times.len() && self.times[self.values.len()] < upto {
+            let t = self.times[self.values.len()];
+            self.values.push(f(t));
+        }
+    }
+}
+
 /// Run the model from `t0`, at rest unless `initial` = (θ0, θ0') is given.
 pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings) -> Simulation {
+    simulate_at(model, ground, t0, initial, settings, &[]).0
+}
+
+/// As [`simulate`], and θ at the sorted `outputs` times (before `t0`: the initial θ).
+pub fn simulate_at(
+    model: &RockingModel,
+    ground: &Ground,
+    t0: f64,
+    initial: Option<State>,
+    settings: &Settings,
+    outputs: &[f64],
+) -> (Simulation, Vec<f64>) {
+    let mut out = Outputs {
+        times: outputs,
+        values: Vec::with_capacity(outputs.len()),
+    };
+    let th0 = initial.map_or(0.0, |s| s[0]);
+    out.fill(t0, |_| th0);
+    let sim = simulate_inner(model, ground, t0, initial, settings, &mut out);
+    let last = sim.history.last().map_or(th0, |s| s.theta);
+    let last = if settings.keep_history { last } else { f64::NAN };
+    let fill_value = if last.is_nan() {
+        out.values.last().copied().unwrap_or(th0)
+    } else {
+        last
+    };
+    out.fill(f64::INFINITY, |_| fill_value);
+    (sim, out.values)
+}
+
+fn simulate_inner(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings, out: &mut Outputs) -> Simulation {
     let mut sim = Simulation {
         stop: Stop::End,
         events: Vec::new(),
@@ -140,7 +188,9 @@ pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<
         match phase {
             Phase::Rest => {
                 y = [0.0, 0.0];
-                match next_uplift(ground, t, settings.t_end, thr) {
+                let next = next_uplift(ground, t, settings.t_end, thr);
+                out.fill(next.map_or(settings.t_end, |n| n.0), |_| 0.0);
+                match next {
                     Some((tu, side)) => {
                         if tu > t {
                             push(&mut sim, tu, &y);
@@ -188,6 +238,8 @@ pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<
                         continue;
                     }
                     track_extremum(&mut sim, &st.dense, t, hh, &y, &st.y1);
+                    let dense = st.dense;
+                    out.fill(ev.map_or(t + hh, |e| e.0), |x| dense.at(x)[0]);
                     match ev {
                         None => {
                             t += hh;

@@ -97,7 +97,20 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 
 /// Reduce every test of a campaign (in parallel) and compute the means.
 pub fn reduce_campaign(campaign: Campaign, options: PeakOptions) -> CampaignResult {
-    let tests: Vec<TestOutcome> = campaign.tests.par_iter().map(|s| reduce_test(&campaign, s, &options)).collect();
+    reduce_campaign_with(campaign, options, &|| {})
+}
+
+/// As [`reduce_campaign`], calling `tick` after each test (progress display).
+pub fn reduce_campaign_with(campaign: Campaign, options: PeakOptions, tick: &(dyn Fn() + Sync)) -> CampaignResult {
+    let tests: Vec<TestOutcome> = campaign
+        .tests
+        .par_iter()
+        .map(|s| {
+            let o = reduce_test(&campaign, s, &options);
+            tick();
+            o
+        })
+        .collect();
     let rows: Vec<Row> = tests
         .iter()
         .map(|t| Row {

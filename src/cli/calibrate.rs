@@ -34,6 +34,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
 }
 
 pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow::Result<Calibration> {
+    // Everything reduce writes, then the calibration on top.
+    let reduce_svgs = rocklab::report::write_reduce_outputs(res, out, true)?;
     let start = std::time::Instant::now();
     let cal = calibrate(res, n);
     let wall = start.elapsed().as_secs_f64();
@@ -56,7 +58,11 @@ pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow
         "wall_s": wall,
     });
     write_atomic(&out.join("summary.json"), &serde_json::to_vec_pretty(&summary)?)?;
-    plots_for(res, &cal, out)?;
+    let figs = plots_for(res, &cal, out)?;
+    let tabs = rocklab::report::tables::tables(res);
+    let section = calibration_html(&cal, n, &figs);
+    let page = rocklab::report::html::reduce_page(res, &tabs, &reduce_svgs, &[section]);
+    write_atomic(&out.join("report.html"), page.as_bytes())?;
     say(&format!(
         "calibration of {} ({} rocking), {} impacts per test, {:.2} s:",
         cal.campaign, cal.rocking, n, wall
@@ -102,7 +108,51 @@ pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow
     Ok(cal)
 }
 
-fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Result<()> {
+/// The calibration section of report.html.
+fn calibration_html(cal: &Calibration, n: usize, figs: &[(String, String)]) -> String {
+    use rocklab::report::html::escape;
+    let mut s = format!(
+        "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
+        if cal.rocking == "one-sided" { " and inward spring" } else { "" },
+        escape(&cal.included.join(", ")),
+        cal.e_in,
+        cal.r_in,
+        cal.e_out,
+        cal.r_out,
+        cal.e_housner
+    );
+    if let Some(j) = &cal.joint {
+        s.push_str(&format!(
+            "<p>One joint fit over the same tests: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",
+            j.e_in,
+            1.96 * j.se_e_in,
+            j.e_out,
+            1.96 * j.se_e_out,
+            j.rms_mm,
+            j.iterations,
+            j.stop
+        ));
+    }
+    s.push_str("<table class=\"paper\" id=\"calibration\"><thead><tr><th>test</th><th>e_in</th><th>95 % interval</th><th>e_out</th><th>95 % interval</th><th>RMS (mm)</th><th>NRMSE</th><th>iterations</th><th>stop</th><th>per-impact e from the data (in / out)</th></tr></thead><tbody>\n");
+    for t in &cal.tests {
+        let per = cal.per_impact.iter().find(|p| p.0 == t.id).map(|(_, i, o)| {
+            let f = |v: &Vec<f64>| v.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(" ");
+            format!("{} / {}", f(i), f(o))
+        });
+        s.push_str(&format!(
+            "<tr data-test=\"{}\"><td>{}</td><td>{:.3}</td><td>{:.3}–{:.3}</td><td>{:.3}</td><td>{:.3}–{:.3}</td><td>{:.3}</td><td>{:.4}</td><td>{}</td><td>{:?}</td><td>{}</td></tr>\n",
+            escape(&t.id), escape(&t.id), t.e_in, t.ci95_e_in[0], t.ci95_e_in[1], t.e_out, t.ci95_e_out[0], t.ci95_e_out[1], t.rms_mm, t.nrmse, t.iterations, t.stop, per.unwrap_or_default()
+        ));
+    }
+    s.push_str("</tbody></table>\n");
+    for (caption, svg) in figs {
+        s.push_str(&format!("<figure>{svg}<figcaption>{}</figcaption></figure>\n", escape(caption)));
+    }
+    s
+}
+
+fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Result<Vec<(String, String)>> {
+    let mut figs = Vec::new();
     let dir = out.join("plots");
     std::fs::create_dir_all(&dir)?;
     for f in &cal.tests {
@@ -153,7 +203,14 @@ fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Res
                 x_range: None,
             },
         ];
-        plots::render(&dir.join(format!("{}_replay", f.id)), &panels, 1000, 320)?;
+        let svg = plots::render(&dir.join(format!("{}_replay", f.id)), &panels, 1000, 320)?;
+        figs.push((
+            format!(
+                "Test {}: measured displacement and the solver's replay with the fitted coefficients, and the residual.",
+                f.id
+            ),
+            svg,
+        ));
     }
     // Fitted coefficients per test with their 95 % intervals (interval ends as
     // small markers joined by the point).
@@ -196,6 +253,10 @@ fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Res
         hline: Some((cal.e_in, format!("mean e_in {:.3}", cal.e_in))),
         x_range: Some((0.5, cal.tests.len() as f64 + 0.5)),
     };
-    plots::render(&dir.join("coefficients"), &[panel], 900, 450)?;
-    Ok(())
+    let svg = plots::render(&dir.join("coefficients"), &[panel], 900, 450)?;
+    figs.insert(
+        0,
+        ("Fitted e_in (red) and e_out (blue) per test with their 95 % intervals.".to_string(), svg),
+    );
+    Ok(figs)
 }

@@ -14,7 +14,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_and_write(campaign, PeakOptions::default(), &args.out.join(name), true)?;
         ok &= res.failed().next().is_none();
-        let cal = super::calibrate::calibrate_and_write(&res, &args.out.join(name).join("calibration"), 6)?;
+        let cal = super::calibrate::calibrate_and_write(&res, &args.out.join(name), 6)?;
         ok &= cal.failed.is_empty();
         say("");
     }
@@ -22,7 +22,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     say(&format!("façade study: {}", study.name));
     let out = args.out.join("facade");
     std::fs::create_dir_all(&out)?;
-    super::facade::study_outputs(&study, &out)?;
+    let (runs, figs, md) = super::facade::study_outputs(&study, &out)?;
+    super::facade::write_report(&study, &runs, &md, &figs, &Vec::new(), &out)?;
     say(&format!("wrote {}", out.display()));
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use super::say;
@@ -24,29 +23,102 @@ pub struct FacadeArgs {
     pub scales: Option<String>,
 }
 
-/// A progress bar on a terminal, hidden otherwise (indicatif draws to stderr only
-/// when it is a terminal).
-fn progress(n: usize, what: &str) -> ProgressBar {
-    let pb = ProgressBar::new(n as u64);
-    pb.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})").unwrap_or_else(|_| ProgressStyle::default_bar()));
-    pb.set_message(what.to_string());
-    pb
-}
+use super::progress;
 
 pub fn run(a: FacadeArgs) -> anyhow::Result<ExitCode> {
     let study = Study::load(&a.study)?;
     let scales = a.scales.as_deref().map(parse_scales).transpose()?;
     std::fs::create_dir_all(&a.out)?;
-    study_outputs(&study, &a.out)?;
-    if let Some(sc) = scales {
-        ida_outputs(&study, &sc, &a.out)?;
-    }
+    let (runs, figs, md) = study_outputs(&study, &a.out)?;
+    let ida_figs = match scales {
+        Some(sc) => ida_outputs(&study, &sc, &a.out)?,
+        None => Vec::new(),
+    };
+    write_report(&study, &runs, &md, &figs, &ida_figs, &a.out)?;
     say(&format!("wrote {}", a.out.display()));
     Ok(ExitCode::SUCCESS)
 }
 
+/// Figures for the HTML report: (caption, SVG).
+pub type Figures = Vec<(String, String)>;
+
+/// The façade report.html: results, response plots, IDA plots, provenance.
+pub fn write_report(study: &Study, runs: &[StudyRun], md: &str, figs: &Figures, ida: &Figures, out: &Path) -> anyhow::Result<()> {
+    use rocklab::report::html::{file_facts, Page};
+    let mut page = Page::new(&format!("{} — Housner against calibrated coefficients", study.name));
+    page.p(&format!(
+        "Block: {} (α = {} rad, R = {} m, I_0 = {:.4e} kg m², p² = {:.4} s⁻²). Ground motions ×{}; polarities {:?}; overturning at θ = {} rad; integration rtol {:e}. Housner's e_H by Eq. 2 with α = {}: {:.3}.",
+        study.block.name, study.block.block.alpha, study.block.block.r_m, study.block.block.i0, study.block.block.p2(),
+        study.magnification, study.polarities, study.overturn_limit, study.rtol, study.block.block.alpha, study.e_housner_eq2
+    ));
+    page.h2("Results");
+    page.raw(&md_table_to_html(md));
+    page.h2("Responses");
+    for (c, svg) in figs {
+        page.figure(svg, c);
+    }
+    if !ida.is_empty() {
+        page.h2("Incremental dynamic analysis");
+        for (c, svg) in ida {
+            page.figure(svg, c);
+        }
+    }
+    page.h2("Provenance");
+    let mut files = Vec::new();
+    for (what, p) in [
+        ("study", study.path.clone()),
+        ("block", study.path.parent().unwrap_or(Path::new(".")).join("block.toml")),
+    ] {
+        if p.is_file() {
+            let (size, sha) = file_facts(&p);
+            files.push(vec![what.to_string(), p.display().to_string(), size, sha]);
+        }
+    }
+    for r in &study.records {
+        let (size, sha) = file_facts(&r.record.path);
+        files.push(vec![r.name.clone(), r.record.path.display().to_string(), size, sha]);
+    }
+    page.table("meta", &["input", "file", "size", "SHA-256"], &files);
+    for r in &study.records {
+        if !r.record.notes.is_empty() {
+            page.p(&format!("{}: {}", r.name, r.record.notes.join("; ")));
+        }
+    }
+    let _ = runs;
+    page.p(&format!("Tool: rocklab {}.", env!("CARGO_PKG_VERSION")));
+    write_atomic(&out.join("report.html"), page.finish().as_bytes())?;
+    Ok(())
+}
+
+/// The Markdown results table as HTML (first table of the text; the caption after it).
+fn md_table_to_html(md: &str) -> String {
+    use rocklab::report::html::escape;
+    let mut s = String::from("<table class=\"paper\" id=\"results\">");
+    let mut caption = String::new();
+    for (i, line) in md.lines().enumerate() {
+        if !line.starts_with('|') {
+            if !line.trim().is_empty() {
+                caption.push_str(line);
+            }
+            continue;
+        }
+        if i == 1 {
+            continue;
+        }
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(|c| c.trim()).collect();
+        let tag = if i == 0 { "th" } else { "td" };
+        s.push_str("<tr>");
+        for c in cells {
+            s.push_str(&format!("<{tag}>{}</{tag}>", escape(c)));
+        }
+        s.push_str("</tr>\n");
+    }
+    s.push_str(&format!("<caption>{}</caption></table>\n", escape(&caption)));
+    s
+}
+
 /// Run the study at scale 1 and write summary.json, results.{csv,md} and plots.
-pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<Vec<StudyRun>> {
+pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Vec<StudyRun>, Figures, String)> {
     let pb = progress(study.combinations().len(), "façade runs");
     let start = std::time::Instant::now();
     let runs = run_study(study, 1.0, true, &|| pb.inc(1));
@@ -69,6 +141,7 @@ pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<Vec<StudyRun>>
     write_atomic(&out.join("results.csv"), &csv)?;
     write_atomic(&out.join("results.md"), md.as_bytes())?;
     say(&md);
+    let mut figs = Figures::new();
     for rec in &study.records {
         let ag = rec
             .record
@@ -96,9 +169,16 @@ pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<Vec<StudyRun>>
                 panels.insert(panels.len() - 1, ps.remove(0));
             }
         }
-        plots::render(&out.join(format!("response_{}", rec.name)), &panels, 1000, 300)?;
+        let svg = plots::render(&out.join(format!("response_{}", rec.name)), &panels, 1000, 300)?;
+        figs.push((
+            format!(
+                "{}: θ/α under each coefficient set, per polarity, and the scaled ground acceleration (paper Fig. 8/9).",
+                rec.name
+            ),
+            svg,
+        ));
     }
-    Ok(runs)
+    Ok((runs, figs, md))
 }
 
 fn results_table(study: &Study, runs: &[StudyRun]) -> anyhow::Result<(Vec<u8>, String)> {
@@ -195,7 +275,8 @@ fn results_table(study: &Study, runs: &[StudyRun]) -> anyhow::Result<(Vec<u8>, S
 }
 
 /// IDA: per point CSV, fraction overturning per scale and set, plots.
-fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<()> {
+fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<Figures> {
+    let mut figs = Figures::new();
     let n = scales.len() * study.combinations().len();
     let pb = progress(n, "IDA runs");
     let start = std::time::Instant::now();
@@ -249,7 +330,14 @@ fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<()> 
             hline: None,
             x_range: None,
         };
-        plots::render(&out.join(format!("ida_{}", set.name)), &[panel], 900, 450)?;
+        let svg = plots::render(&out.join(format!("ida_{}", set.name)), &[panel], 900, 450)?;
+        figs.push((
+            format!(
+                "IDA with the {} coefficients: max θ/α against the scale factor per record and polarity.",
+                set.name
+            ),
+            svg,
+        ));
     }
     write_atomic(&out.join("ida_fraction.csv"), &f.into_inner()?)?;
     let panel = Panel {
@@ -260,7 +348,8 @@ fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<()> 
         hline: None,
         x_range: None,
     };
-    plots::render(&out.join("ida_fraction"), &[panel], 900, 450)?;
+    let svg = plots::render(&out.join("ida_fraction"), &[panel], 900, 450)?;
+    figs.push(("Fraction of the records × polarities that overturn at each scale.".to_string(), svg));
     say(&format!(
         "IDA: {} runs ({} scales × {} combinations) in {:.2} s",
         pts.len(),
@@ -268,5 +357,5 @@ fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<()> 
         study.combinations().len(),
         wall
     ));
-    Ok(())
+    Ok(figs)
 }

@@ -7,7 +7,7 @@ use anyhow::Context;
 use super::{say, EstimatorArgs, MethodArg, ReduceArgs};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::{Method, PeakOptions};
-use rocklab::reduce::{reduce_campaign, CampaignResult};
+use rocklab::reduce::{reduce_campaign_with, CampaignResult};
 use rocklab::report;
 use rocklab::signal::savgol::SavGol;
 
@@ -38,7 +38,9 @@ pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::
         campaign.e_housner,
         campaign.e_housner_source
     ));
-    let res = reduce_campaign(campaign, opts);
+    let pb = super::progress(campaign.tests.len(), "reducing tests");
+    let res = reduce_campaign_with(campaign, opts, &|| pb.inc(1));
+    pb.finish_and_clear();
     report::write_reduce_outputs(&res, out, plots).with_context(|| format!("writing {}", out.display()))?;
     for t in &res.tests {
         for w in &t.warnings {

@@ -1,6 +1,7 @@
 //! The output edge: the `summary.json` contract, the tables as CSV and Markdown,
 //! and the plots. Renderers return bytes; [`crate::atomic::write_atomic`] writes.
 
+pub mod html;
 pub mod plots;
 pub mod summary;
 pub mod tables;
@@ -15,36 +16,50 @@ use crate::reduce::{CampaignResult, Reduced};
 use crate::restitution::local_ratios;
 use plots::{Panel, Series};
 
-/// Write everything `reduce` produces into `out`: summary.json, tables (CSV and
-/// Markdown), and per-test plots (PNG and SVG) unless `with_plots` is false.
-pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) -> Result<()> {
+/// SVG texts of the plots of one test: (id, motion, ratios).
+pub type TestSvgs = Vec<(String, String, String)>;
+
+/// Write everything `reduce` produces into `out`: summary.json, tables (CSV,
+/// Markdown, LaTeX), per-test plots (PNG and SVG) unless `with_plots` is false, and
+/// the self-contained report.html. Returns the plots' SVG texts.
+pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) -> Result<TestSvgs> {
     std::fs::create_dir_all(out)?;
     let json = serde_json::to_vec_pretty(&summary::summary(res))?;
     write_atomic(&out.join("summary.json"), &json)?;
     let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
-    for t in tables::tables(res) {
-        write_atomic(&out.join(format!("{}.csv", t.name)), &tables::to_csv(&t)?)?;
-        let one = tables::to_markdown(&t);
+    let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
+    let tabs = tables::tables(res);
+    for t in &tabs {
+        write_atomic(&out.join(format!("{}.csv", t.name)), &tables::to_csv(t)?)?;
+        let one = tables::to_markdown(t);
         write_atomic(&out.join(format!("{}.md", t.name)), one.as_bytes())?;
         md.push_str(&one);
         md.push('\n');
+        tex.push_str(&tables::to_latex(t));
+        tex.push('\n');
     }
     md.push_str(&format!("Velocity peaks: {}.\n", res.options.method.describe()));
     write_atomic(&out.join("tables.md"), md.as_bytes())?;
+    write_atomic(&out.join("tables.tex"), tex.as_bytes())?;
+    let mut svgs: TestSvgs = Vec::new();
     if with_plots {
         let dir = out.join("plots");
         std::fs::create_dir_all(&dir)?;
-        res.tests
+        svgs = res
+            .tests
             .par_iter()
             .filter_map(|t| t.result.as_ref().ok().map(|r| (t.spec.id.as_str(), r)))
-            .try_for_each(|(id, r)| test_plots(&dir, id, r, res.campaign.e_housner))?;
+            .map(|(id, r)| test_plots(&dir, id, r, res.campaign.e_housner).map(|(m, q)| (id.to_string(), m, q)))
+            .collect::<Result<Vec<_>>>()?;
     }
-    Ok(())
+    let page = html::reduce_page(res, &tabs, &svgs, &[]);
+    write_atomic(&out.join("report.html"), page.as_bytes())?;
+    Ok(svgs)
 }
 
 /// Paper Fig. 3/4 (displacement and velocity with the peaks) and Fig. 5 (local
 /// ratios with their mean) for one test.
-fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
+fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<(String, String)> {
     let a = &r.analysis;
     let t = &r.log.time_s;
     let last = a.impacts.last().map_or(a.release_time_s + 1.0, |i| i.time_s);
@@ -107,7 +122,7 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
             x_range: None,
         },
     ];
-    plots::render(&dir.join(format!("{id}_motion")), &motion, 1000, 340)?;
+    let motion_svg = plots::render(&dir.join(format!("{id}_motion")), &motion, 1000, 340)?;
     let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
     let ratios = [Panel {
@@ -123,6 +138,6 @@ fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<()> {
         hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
         x_range: None,
     }];
-    plots::render(&dir.join(format!("{id}_ratios")), &ratios, 800, 400)?;
-    Ok(())
+    let ratios_svg = plots::render(&dir.join(format!("{id}_ratios")), &ratios, 800, 400)?;
+    Ok((motion_svg, ratios_svg))
 }

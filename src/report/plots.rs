@@ -147,8 +147,9 @@ where
     Ok(())
 }
 
-/// Render stacked panels to `stem.png` and `stem.svg` (atomically).
-pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) -> Result<()> {
+/// Render stacked panels to `stem.png` and `stem.svg` (atomically); returns the
+/// SVG text (for inlining in HTML reports).
+pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) -> Result<String> {
     register_font();
     let size = (width, height_per_panel * panels.len() as u32);
     let mut svg = String::new();
@@ -158,7 +159,7 @@ pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) 
     draw_figure(BitMapBackend::with_buffer(&mut buf, size).into_drawing_area(), panels)?;
     let png = encode_png(&buf, size.0, size.1)?;
     write_atomic(&stem.with_extension("png"), &png)?;
-    Ok(())
+    Ok(svg)
 }
 
 /// Encode an RGB buffer as PNG (through the `image` crate that plotters' bitmap

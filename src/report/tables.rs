@@ -186,3 +186,104 @@ fn first_words(e: &str) -> String {
     let e = e.rsplit(": ").next().unwrap_or(e);
     e.chars().take(40).collect::<String>().replace('|', "/")
 }
+
+/// LaTeX (booktabs): percent rounded like the paper, caption, label.
+pub fn to_latex(t: &Table) -> String {
+    let cols = t.columns.len();
+    let mut s = format!(
+        "\\begin{{table}}[htbp]\n  \\centering\n  \\caption{{{}}}\n  \\label{{tab:{}}}\n  \\begin{{tabular}}{{l{}}}\n    \\toprule\n",
+        latex_escape(&t.caption),
+        t.name,
+        "r".repeat(cols)
+    );
+    s.push_str(&format!(
+        "    Test & {} \\\\\n    \\midrule\n",
+        t.columns.iter().map(|c| latex_label(c.0)).collect::<Vec<_>>().join(" & ")
+    ));
+    for (id, vals) in &t.rows {
+        let cells = match vals {
+            Ok(v) => v.iter().map(|x| format!("{:.0}\\%", 100.0 * x)).collect::<Vec<_>>(),
+            Err(_) => vec!["--".to_string(); cols],
+        };
+        s.push_str(&format!("    {} & {} \\\\\n", latex_escape(id), cells.join(" & ")));
+    }
+    if let Some((label, v)) = &t.mean {
+        s.push_str("    \\midrule\n");
+        s.push_str(&format!(
+            "    {} & {} \\\\\n",
+            latex_escape(label),
+            v.iter().map(|x| format!("{:.0}\\%", 100.0 * x)).collect::<Vec<_>>().join(" & ")
+        ));
+    }
+    s.push_str("    \\bottomrule\n  \\end{tabular}\n\\end{table}\n");
+    s
+}
+
+fn latex_label(name: &str) -> String {
+    match name {
+        "r_plus" => "$r^+$".into(),
+        "r_minus" => "$r^-$".into(),
+        "r" => "$r$".into(),
+        "r2" => "$r$ (2 impacts)".into(),
+        "r1_plus" => "$r_1^+$".into(),
+        "r1_minus" => "$r_1^-$".into(),
+        "r1" => "$r_1$".into(),
+        other => latex_escape(other),
+    }
+}
+
+/// Escape LaTeX's special characters (and spell the Unicode the captions use).
+pub fn latex_escape(s: &str) -> String {
+    let mut o = String::new();
+    for c in s.chars() {
+        match c {
+            '_' | '%' | '&' | '#' | '$' | '{' | '}' => {
+                o.push('\\');
+                o.push(c);
+            }
+            '⁺' => o.push_str("$^+$"),
+            '⁻' => o.push_str("$^-$"),
+            '₁' => o.push_str("$_1$"),
+            'α' => o.push_str("$\\alpha$"),
+            '−' => o.push('-'),
+            '²' => o.push_str("$^2$"),
+            _ => o.push(c),
+        }
+    }
+    o
+}
+
+/// HTML: caption, then the table in percent (a failed test shows its reason).
+pub fn to_html(t: &Table) -> String {
+    use super::html::escape;
+    let mut s = format!(
+        "<table class=\"paper\" id=\"{}\">\n<caption>{}</caption>\n<thead><tr><th>test#</th>",
+        t.name,
+        escape(&t.caption)
+    );
+    for c in &t.columns {
+        s.push_str(&format!("<th data-col=\"{}\">{}</th>", c.0, escape(c.1)));
+    }
+    s.push_str("</tr></thead>\n<tbody>\n");
+    for (id, vals) in &t.rows {
+        s.push_str(&format!("<tr data-test=\"{}\"><td>{}</td>", escape(id), escape(id)));
+        match vals {
+            Ok(v) => {
+                for (c, x) in t.columns.iter().zip(v) {
+                    s.push_str(&format!("<td data-col=\"{}\" data-value=\"{x}\">{}</td>", c.0, percent(*x)));
+                }
+            }
+            Err(e) => s.push_str(&format!("<td colspan=\"{}\" class=\"error\">{}</td>", t.columns.len(), escape(e))),
+        }
+        s.push_str("</tr>\n");
+    }
+    if let Some((label, v)) = &t.mean {
+        s.push_str(&format!("<tr class=\"mean\" data-test=\"mean\"><td>{}</td>", escape(label)));
+        for (c, x) in t.columns.iter().zip(v) {
+            s.push_str(&format!("<td data-col=\"{}\" data-value=\"{x}\">{}</td>", c.0, percent(*x)));
+        }
+        s.push_str("</tr>\n");
+    }
+    s.push_str("</tbody></table>\n");
+    s
+}

@@ -32,6 +32,17 @@ pub struct CampaignMeans {
     pub left_out: Vec<(String, String)>,
 }
 
+impl CampaignMeans {
+    /// "50_1 (exclude_from_mean), 100_2 (not reduced)".
+    pub fn left_out_text(&self) -> String {
+        self.left_out
+            .iter()
+            .map(|(id, why)| format!("{id} ({why})"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
 pub fn campaign_means(rows: &[Row]) -> CampaignMeans {
     let mut included = Vec::new();
     let mut left_out = Vec::new();

@@ -50,15 +50,7 @@ pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::
     let tables = report::tables::tables(&res);
     say(&report::tables::to_markdown(&tables[0]));
     if !res.means.left_out.is_empty() {
-        say(&format!(
-            "means leave out: {}",
-            res.means
-                .left_out
-                .iter()
-                .map(|(id, why)| format!("{id} ({why})"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
+        say(&format!("means leave out: {}", res.means.left_out_text()));
     }
     say(&format!("wrote {}", out.display()));
     let failed: Vec<_> = res.failed().collect();

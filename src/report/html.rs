@@ -134,15 +134,7 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
     }
     page.h2("Tables");
     if !res.means.left_out.is_empty() {
-        page.p(&format!(
-            "Means leave out: {}.",
-            res.means
-                .left_out
-                .iter()
-                .map(|(id, why)| format!("{id} ({why})"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
+        page.p(&format!("Means leave out: {}.", res.means.left_out_text()));
     }
     for t in tabs {
         page.raw(&to_html(t));

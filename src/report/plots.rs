@@ -108,11 +108,15 @@ where
             // Thick polylines of dense series render with gaps in the bitmap
             // backend: one pixel is enough there.
             let width = if s.points.len() > 1500 { 1 } else { 2 };
-            chart
+            let drawn = chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(width)))
-                .map_err(err)?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                .map_err(err)?;
+            // A series without a label (an interval bar) stays out of the legend.
+            if !s.label.is_empty() {
+                drawn
+                    .label(s.label.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            }
         }
     }
     if let Some((h, label)) = &panel.hline {

@@ -47,9 +47,9 @@ pub fn write_report(study: &Study, runs: &[StudyRun], md: &str, figs: &Figures, 
     use rocklab::report::html::{file_facts, Page};
     let mut page = Page::new(&format!("{} — Housner against calibrated coefficients", study.name));
     page.p(&format!(
-        "Block: {} (α = {} rad, R = {} m, I_0 = {:.4e} kg m², p² = {:.4} s⁻²). Ground motions ×{}; polarities {:?}; overturning at θ = {} rad; integration rtol {:e}. Housner's e_H by Eq. 2 with α = {}: {:.3}.",
+        "Block: {} (α = {} rad, R = {} m, I_0 = {:.4e} kg m², p² = {:.4} s⁻²). Ground motions ×{}; polarities {}; overturning at θ = {} rad; integration rtol {:e}. Housner's e_H by Eq. 2 with α = {}: {:.3}.",
         study.block.name, study.block.block.alpha, study.block.block.r_m, study.block.block.i0, study.block.block.p2(),
-        study.magnification, study.polarities, study.overturn_limit, study.rtol, study.block.block.alpha, study.e_housner_eq2
+        study.magnification, study.polarities.iter().map(|p| format!("{:+}", *p as i8)).collect::<Vec<_>>().join(", "), study.overturn_limit, study.rtol, study.block.block.alpha, study.e_housner_eq2
     ));
     page.h2("Results");
     page.raw(&md_table_to_html(md));

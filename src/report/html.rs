@@ -23,7 +23,7 @@ table.paper { border-top: 2px solid #222; border-bottom: 2px solid #222; } table
 th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child { text-align: left; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
-pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; white-space: nowrap; }
+pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; }
 .warn { color: #8a5a00; }
 @page { size: A4; margin: 15mm; }
 @media print { body { max-width: none; margin: 0; } h2 { page-break-after: avoid; } }
@@ -150,7 +150,7 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
             );
         }
     }
-    page.table("meta", &["test", "v0 (mm/s)", "v1", "v2", "v3", "v4", "v5"], &rows);
+    page.table("meta peaks", &["test", "v0 (mm/s)", "v1", "v2", "v3", "v4", "v5"], &rows);
     for x in extra {
         page.raw(x);
     }

@@ -152,3 +152,32 @@ fn malformed_files_name_the_line() {
     let e = read(Path::new("/nonexistent/rec.asc"), &ReadOptions::default()).unwrap_err().to_string();
     assert!(e.contains("rec.asc") && e.contains("not found"), "{e}");
 }
+
+/// The shipped synthetic pulse in every format reads back the same samples as the
+/// two-column file. Tolerances follow each file's printed precision: E15.7 (8
+/// significant digits), F10.6 (5e-7 g), COSMOS 1E15.6 in cm/s² (7 significant digits).
+#[test]
+fn synthetic_pulse_in_every_format() {
+    let reference = read(
+        &gm("synthetic/one_sine_pulse.csv"),
+        &ReadOptions {
+            units: Some(Units::G),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let g = rocklab::G;
+    for (file, format, tol_g) in [
+        ("synthetic/one_sine_pulse_nga.AT2", Format::At2, 1e-7),
+        ("synthetic/one_sine_pulse_old.AT2", Format::At2, 5e-7),
+        ("synthetic/one_sine_pulse.V2", Format::Cosmos, 1e-6),
+    ] {
+        let r = read(&gm(file), &ReadOptions::default()).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!(r.format, format, "{file}");
+        assert!((r.dt - 0.005).abs() < 1e-12, "{file}: dt {}", r.dt);
+        assert_eq!(r.acc_m_s2.len(), reference.acc_m_s2.len(), "{file}");
+        for (a, b) in r.acc_m_s2.iter().zip(&reference.acc_m_s2) {
+            assert!((a - b).abs() / g <= tol_g, "{file}: {} vs {} g", a / g, b / g);
+        }
+    }
+}

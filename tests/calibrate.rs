@@ -10,60 +10,26 @@ use rocklab::calibrate::calibrate;
 use rocklab::ingest::Campaign;
 use rocklab::peaks::PeakOptions;
 use rocklab::reduce::reduce_campaign;
-use rocklab::solver::{simulate_at, Ground, Restraint, RockingModel, Settings};
-use rocklab::wall::{p_squared_rectangular, slenderness};
 
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        (-2.0 * self.uniform().ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
+mod common;
+use common::{synthetic_log, LogSpec};
 
 const E_IN: f64 = 0.55;
 const E_OUT: f64 = 0.75;
 const KAPPA: f64 = 80.0;
 
-/// One log: hold, release at t_r from x0, free one-sided rocking, rest.
 fn log(fs: f64, sigma: f64, drift_mm: f64, x0_mm: f64, seed: u64) -> String {
-    let (h, b, lever) = (2.47, 0.36, 2330.0);
-    let model = RockingModel {
-        alpha: slenderness(b, h),
-        p2: p_squared_rectangular(h, b),
-        i0: 1.0,
-        restraint: Restraint::Rotational { k_nm_per_rad: KAPPA },
-        ties: Vec::new(),
+    synthetic_log(&LogSpec {
+        kappa: KAPPA,
         e_in: E_IN,
         e_out: E_OUT,
-        overturn_limit: 1.0,
-        linearized: false,
-    };
-    let duration = 8.0;
-    let n = (duration * fs) as usize;
-    let t: Vec<f64> = (0..n).map(|i| i as f64 / fs).collect();
-    let t_r = 1.3 + 0.37 / fs;
-    let theta0 = (x0_mm / lever).asin();
-    let ground = Ground {
-        t0: 0.0,
-        dt: 1.0,
-        acc: vec![0.0, 0.0],
-    };
-    let mut s = Settings::new(duration).with_tolerances(1e-11, 1e-14).without_history();
-    s.rest_speed = 1e-9;
-    let (_, th) = simulate_at(&model, &ground, t_r, Some([theta0, 0.0]), &s, &t);
-    let mut rng = Rng(seed);
-    let mut out = String::from("# synthetic\ntime_s,disp_mm\n");
-    for (ti, thi) in t.iter().zip(&th) {
-        let x = lever * thi.sin() + drift_mm * ti / duration + sigma * rng.normal();
-        out.push_str(&format!("{ti:.4},{:.2}\n", (x * 100.0).round() / 100.0));
-    }
-    out
+        fs,
+        sigma_mm: sigma,
+        drift_mm,
+        x0_mm,
+        seed,
+    })
+    .0
 }
 
 #[test]

@@ -100,3 +100,51 @@ fn robust_to_decimation_spikes_clock_offset_and_drift() {
         }
     }
 }
+
+mod common;
+
+/// One-sided rocking where gravity outweighs a soft inward restraint (λ < 0: the
+/// inward arcs are cosh-shaped, as with short transverse walls), and a stiff one, on
+/// logs made with the project's solver (200 Hz, σ = 0.02 mm, drift, 0.01 mm
+/// quantisation): every table value within 1.0 pp of the values from the solver's
+/// exact impact speeds.
+#[test]
+fn soft_and_stiff_inward_restraint_from_solver_logs() {
+    use common::{synthetic_log, LogSpec, LEVER_MM};
+    use rocklab::peaks::{analyse, Physics};
+    use rocklab::restitution::coefficients;
+    use rocklab::wall::p_squared_rectangular;
+    let p2 = p_squared_rectangular(2.47, 0.36);
+    for (name, kappa) in [("soft (κ = 0.5 p²)", 0.5 * p2), ("stiff (κ = 15 p²)", 15.0 * p2)] {
+        let spec = LogSpec {
+            kappa,
+            e_in: 0.6,
+            e_out: 0.75,
+            fs: 200.0,
+            sigma_mm: 0.02,
+            drift_mm: 0.06,
+            x0_mm: 130.0,
+            seed: 5,
+        };
+        let (csv, truth) = synthetic_log(&spec);
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("log.csv");
+        std::fs::write(&f, csv).unwrap();
+        let log = rocklab::ingest::LogReader::new(&f).read().unwrap();
+        let phys = Physics {
+            rocking: rocklab::ingest::Rocking::OneSided,
+            lever_arm_mm: LEVER_MM,
+            p_guess: p2.sqrt(),
+        };
+        let a = analyse(&log.time_s, &log.disp_mm, &phys, &PeakOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
+        let eh = 0.9738;
+        let got = serde_json::to_value(coefficients(&v, eh).unwrap()).unwrap();
+        let want = serde_json::to_value(coefficients(&truth[..6], eh).unwrap()).unwrap();
+        for k in KEYS {
+            let err = 100.0 * (got[k].as_f64().unwrap() - want[k].as_f64().unwrap());
+            println!("{name} {k} {err:+.3}");
+            assert!(err.abs() <= 1.0, "{name}: {k} off by {err:.2} pp (λ fitted {:?})", a.lambda_fit);
+        }
+    }
+}

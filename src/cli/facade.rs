@@ -160,11 +160,9 @@ pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Vec<StudyRun>
                 .map(|(i, r)| (r.coefficients.as_str(), r.history.as_slice(), colors[i % colors.len()]))
                 .collect();
             let mut ps = response_panels(&format!("{} polarity {:+}", rec.name, p as i8), &series, study.block.block.alpha, &ag);
+            // One θ/α panel per polarity, the ground acceleration once, last.
             if panels.is_empty() {
-                panels.push(ps.remove(0));
-                panels.push(ps.remove(0));
-                panels.swap(0, 1);
-                panels.rotate_left(1);
+                panels.append(&mut ps);
             } else {
                 panels.insert(panels.len() - 1, ps.remove(0));
             }

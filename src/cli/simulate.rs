@@ -97,20 +97,26 @@ fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
     }
 }
 
-pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
-    let block = BlockSpec::load(&a.block)?;
-    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
-    let from_file = a.calibration.as_deref().map(rocklab::facade::read_calibration).transpose()?;
-    let (e_in, e_out) = match (a.e, a.e_in, a.e_out, block.impact) {
-        _ if from_file.is_some() => from_file.unwrap_or_default(),
+/// e_in, e_out from --e or --e-in/--e-out, else the block file's [impact].
+fn coefficients_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<(f64, f64)> {
+    Ok(match (a.e, a.e_in, a.e_out, block.impact) {
         (Some(e), ..) => (e, e),
         (None, Some(i), Some(o), _) => (i, o),
         (None, None, None, d) => match (d.e, d.e_in, d.e_out) {
             (Some(e), _, _) => (e, e),
             (None, Some(i), Some(o)) => (i, o),
-            _ => bail!("no coefficient of restitution: pass --e E or --e-in X --e-out Y (or set [impact] in the block file)"),
+            _ => bail!("no coefficient of restitution: pass --e E, --e-in X --e-out Y or --calibration FILE (or set [impact] in the block file)"),
         },
         _ => bail!("pass --e E, or both --e-in and --e-out"),
+    })
+}
+
+pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
+    let block = BlockSpec::load(&a.block)?;
+    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let (e_in, e_out) = match &a.calibration {
+        Some(file) => rocklab::facade::read_calibration(file)?,
+        None => coefficients_from_args(&a, &block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
     if a.polarity != 1 && a.polarity != -1 {

@@ -105,9 +105,9 @@ mod common;
 
 /// One-sided rocking where gravity outweighs a soft inward restraint (λ < 0: the
 /// inward arcs are cosh-shaped, as with short transverse walls), and a stiff one, on
-/// logs made with the project's solver (200 Hz, σ = 0.02 mm, drift, 0.01 mm
-/// quantisation): every table value within 1.0 pp of the values from the solver's
-/// exact impact speeds.
+/// logs made with the project's solver (100, 200 and 1000 Hz, σ = 0.02–0.05 mm,
+/// drift, 0.01 mm quantisation): every table value within 1.0 pp of the values from
+/// the solver's exact impact speeds.
 #[test]
 fn soft_and_stiff_inward_restraint_from_solver_logs() {
     use common::{synthetic_log, LogSpec, LEVER_MM};
@@ -115,13 +115,19 @@ fn soft_and_stiff_inward_restraint_from_solver_logs() {
     use rocklab::restitution::coefficients;
     use rocklab::wall::p_squared_rectangular;
     let p2 = p_squared_rectangular(2.47, 0.36);
-    for (name, kappa) in [("soft (κ = 0.5 p²)", 0.5 * p2), ("stiff (κ = 15 p²)", 15.0 * p2)] {
+    let cases = [
+        ("soft (κ = 0.5 p²)", 0.5 * p2, 200.0, 0.02),
+        ("stiff (κ = 15 p²)", 15.0 * p2, 200.0, 0.02),
+        ("stiff, 1000 Hz, σ = 0.05 mm", 15.0 * p2, 1000.0, 0.05),
+        ("soft, 100 Hz, σ = 0.03 mm", 0.5 * p2, 100.0, 0.03),
+    ];
+    for (name, kappa, fs, sigma_mm) in cases {
         let spec = LogSpec {
             kappa,
             e_in: 0.6,
             e_out: 0.75,
-            fs: 200.0,
-            sigma_mm: 0.02,
+            fs,
+            sigma_mm,
             drift_mm: 0.06,
             x0_mm: 130.0,
             seed: 5,

@@ -159,7 +159,9 @@ fn defect_short_row_in_the_middle() {
 #[test]
 fn truncated_last_line_is_dropped_with_a_warning() {
     let mut text = good_log();
-    text.push_str("13.020,0.0"); // no line end, missing the third column is fine, but cut mid-number:
+    // A complete row (the unused third column may be missing), then a last line cut
+    // short with no line end.
+    text.push_str("13.020,0.0");
     text.push_str("\n13.025");
     let (dir, manifest) = campaign(&[("cut", "cut.csv", Some(text.into_bytes()), "")]);
     let run = reduce(&manifest, &dir.path().join("out"), &[]);

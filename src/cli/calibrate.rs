@@ -12,8 +12,9 @@ use rocklab::atomic::write_atomic;
 use rocklab::calibrate::{calibrate, to_toml, Calibration};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::PeakOptions;
-use rocklab::reduce::{reduce_campaign, CampaignResult};
+use rocklab::reduce::CampaignResult;
 use rocklab::report::plots::{self, Panel, Series};
+use rocklab::report::{write_reduce_outputs, Extras};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -28,21 +29,18 @@ pub struct CalibrateArgs {
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
     let campaign = Campaign::load(&a.manifest)?;
-    let res = reduce_campaign(campaign, PeakOptions::default());
+    let res = super::reduce::reduce_and_print(campaign, PeakOptions::default());
     let cal = calibrate_and_write(&res, &a.out, a.impacts)?;
     Ok(if cal.failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow::Result<Calibration> {
-    // Everything reduce writes, then the calibration on top.
-    let reduce_svgs = rocklab::report::write_reduce_outputs(res, out, true)?;
     let start = std::time::Instant::now();
     let cal = calibrate(res, n);
     let wall = start.elapsed().as_secs_f64();
     std::fs::create_dir_all(out)?;
     write_atomic(&out.join("calibration.toml"), to_toml(&cal).as_bytes())?;
-    let mut summary = rocklab::report::summary::summary(res);
-    summary["calibration"] = json!({
+    let calibration = json!({
         "e_in": cal.e_in, "e_out": cal.e_out, "r_in": cal.r_in, "r_out": cal.r_out,
         "e_housner": cal.e_housner,
         "included": cal.included,
@@ -57,12 +55,13 @@ pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow
         "failed": cal.failed.iter().map(|(id, e)| json!({"id": id, "error": e})).collect::<Vec<_>>(),
         "wall_s": wall,
     });
-    write_atomic(&out.join("summary.json"), &serde_json::to_vec_pretty(&summary)?)?;
-    let figs = plots_for(res, &cal, out)?;
-    let tabs = rocklab::report::tables::tables(res);
-    let section = calibration_html(&cal, n, &figs);
-    let page = rocklab::report::html::reduce_page(res, &tabs, &reduce_svgs, &[section]);
-    write_atomic(&out.join("report.html"), page.as_bytes())?;
+    // Everything reduce writes, with the calibration in summary.json and report.html.
+    let figs = plots_for(res, &cal, out, n)?;
+    let extra = Extras {
+        summary: [("calibration".to_string(), calibration)].into_iter().collect(),
+        html_sections: vec![calibration_html(&cal, n, &figs)],
+    };
+    write_reduce_outputs(res, out, true, &extra)?;
     say(&format!(
         "calibration of {} ({} rocking), {} impacts per test, {:.2} s:",
         cal.campaign, cal.rocking, n, wall
@@ -151,7 +150,7 @@ fn calibration_html(cal: &Calibration, n: usize, figs: &[(String, String)]) -> S
     s
 }
 
-fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Result<Vec<(String, String)>> {
+fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path, n_impacts: usize) -> anyhow::Result<Vec<(String, String)>> {
     let mut figs = Vec::new();
     let dir = out.join("plots");
     std::fs::create_dir_all(&dir)?;
@@ -160,7 +159,7 @@ fn plots_for(res: &CampaignResult, cal: &Calibration, out: &Path) -> anyhow::Res
             continue;
         };
         let Ok(r) = &t.result else { continue };
-        let Some(w) = rocklab::calibrate::window(&f.id, r, t.spec.lever_arm_m * 1e3, cal.tests.first().map_or(6, |_| 6)) else {
+        let Some(w) = rocklab::calibrate::window(&f.id, r, t.spec.lever_arm_m * 1e3, n_impacts) else {
             continue;
         };
         let n = w.t.len().min(f.replay_mm.len());

@@ -1,8 +1,9 @@
-//! `rocklab demo`: reduce the fixture campaigns into `reports/demo/`.
+//! `rocklab demo`: reduce and calibrate the fixture campaigns and run the façade
+//! study, into `reports/demo/`.
 
 use std::process::ExitCode;
 
-use super::reduce::reduce_and_write;
+use super::reduce::reduce_and_print;
 use super::{say, DemoArgs};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::PeakOptions;
@@ -12,8 +13,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     for name in ["one-sided-demo", "two-sided-demo"] {
         let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
         let campaign = Campaign::load(&manifest)?;
-        let res = reduce_and_write(campaign, PeakOptions::default(), &args.out.join(name), true)?;
+        let res = reduce_and_print(campaign, PeakOptions::default());
         ok &= res.failed().next().is_none();
+        // Writes everything `reduce` writes, then the calibration on top.
         let cal = super::calibrate::calibrate_and_write(&res, &args.out.join(name), 6)?;
         ok &= cal.failed.is_empty();
         say("");
@@ -22,8 +24,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     say(&format!("façade study: {}", study.name));
     let out = args.out.join("facade");
     std::fs::create_dir_all(&out)?;
-    let (runs, figs, md) = super::facade::study_outputs(&study, &out)?;
-    super::facade::write_report(&study, &runs, &md, &figs, &Vec::new(), &out)?;
+    let (figs, md) = super::facade::study_outputs(&study, &out)?;
+    super::facade::write_report(&study, &md, &figs, &[], &out)?;
     say(&format!("wrote {}", out.display()));
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

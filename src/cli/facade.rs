@@ -29,12 +29,12 @@ pub fn run(a: FacadeArgs) -> anyhow::Result<ExitCode> {
     let study = Study::load(&a.study)?;
     let scales = a.scales.as_deref().map(parse_scales).transpose()?;
     std::fs::create_dir_all(&a.out)?;
-    let (runs, figs, md) = study_outputs(&study, &a.out)?;
+    let (figs, md) = study_outputs(&study, &a.out)?;
     let ida_figs = match scales {
         Some(sc) => ida_outputs(&study, &sc, &a.out)?,
         None => Vec::new(),
     };
-    write_report(&study, &runs, &md, &figs, &ida_figs, &a.out)?;
+    write_report(&study, &md, &figs, &ida_figs, &a.out)?;
     say(&format!("wrote {}", a.out.display()));
     Ok(ExitCode::SUCCESS)
 }
@@ -43,7 +43,7 @@ pub fn run(a: FacadeArgs) -> anyhow::Result<ExitCode> {
 pub type Figures = Vec<(String, String)>;
 
 /// The façade report.html: results, response plots, IDA plots, provenance.
-pub fn write_report(study: &Study, runs: &[StudyRun], md: &str, figs: &Figures, ida: &Figures, out: &Path) -> anyhow::Result<()> {
+pub fn write_report(study: &Study, md: &str, figs: &[(String, String)], ida: &[(String, String)], out: &Path) -> anyhow::Result<()> {
     use rocklab::report::html::{file_facts, Page};
     let mut page = Page::new(&format!("{} — Housner against calibrated coefficients", study.name));
     page.p(&format!(
@@ -84,7 +84,6 @@ pub fn write_report(study: &Study, runs: &[StudyRun], md: &str, figs: &Figures, 
             page.p(&format!("{}: {}", r.name, r.record.notes.join("; ")));
         }
     }
-    let _ = runs;
     page.p(&format!("Tool: rocklab {}.", env!("CARGO_PKG_VERSION")));
     write_atomic(&out.join("report.html"), page.finish().as_bytes())?;
     Ok(())
@@ -117,8 +116,9 @@ fn md_table_to_html(md: &str) -> String {
     s
 }
 
-/// Run the study at scale 1 and write summary.json, results.{csv,md} and plots.
-pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Vec<StudyRun>, Figures, String)> {
+/// Run the study at scale 1 and write summary.json, results.{csv,md} and plots;
+/// returns the figures and the Markdown table for the report.
+pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Figures, String)> {
     let pb = progress(study.combinations().len(), "façade runs");
     let start = std::time::Instant::now();
     let runs = run_study(study, 1.0, true, &|| pb.inc(1));
@@ -176,7 +176,7 @@ pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Vec<StudyRun>
             svg,
         ));
     }
-    Ok((runs, figs, md))
+    Ok((figs, md))
 }
 
 fn results_table(study: &Study, runs: &[StudyRun]) -> anyhow::Result<(Vec<u8>, String)> {

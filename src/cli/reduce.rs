@@ -22,12 +22,17 @@ pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
 pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {
     let opts = options(&args.estimator)?;
     let campaign = Campaign::load(&args.manifest)?;
-    let res = reduce_and_write(campaign, opts, &args.out, !args.estimator.no_plots)?;
+    let res = reduce_and_print(campaign, opts);
+    report::write_reduce_outputs(&res, &args.out, !args.estimator.no_plots, &report::Extras::default())
+        .with_context(|| format!("writing {}", args.out.display()))?;
+    say(&format!("wrote {}", args.out.display()));
     Ok(exit_code(&res))
 }
 
-/// Reduce a campaign, write every output and print the summary; shared by `demo`.
-pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::Path, plots: bool) -> anyhow::Result<CampaignResult> {
+/// Reduce a campaign and print what a user reads on the terminal (the campaign,
+/// Table 1, warnings and failures); shared by `calibrate` and `demo`, which write
+/// the outputs themselves.
+pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult {
     say(&format!(
         "campaign {} ({}), {} tests; α = {:.4} rad ({}); e_H = {:.4} ({})",
         campaign.name,
@@ -41,7 +46,6 @@ pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::
     let pb = super::progress(campaign.tests.len(), "reducing tests");
     let res = reduce_campaign_with(campaign, opts, &|| pb.inc(1));
     pb.finish_and_clear();
-    report::write_reduce_outputs(&res, out, plots).with_context(|| format!("writing {}", out.display()))?;
     for t in &res.tests {
         for w in &t.warnings {
             eprintln!("warning: test {}: {w}", t.spec.id);
@@ -52,7 +56,6 @@ pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::
     if !res.means.left_out.is_empty() {
         say(&format!("means leave out: {}", res.means.left_out_text()));
     }
-    say(&format!("wrote {}", out.display()));
     let failed: Vec<_> = res.failed().collect();
     if !failed.is_empty() {
         eprintln!("{} of {} tests failed:", failed.len(), res.tests.len());
@@ -60,7 +63,7 @@ pub fn reduce_and_write(campaign: Campaign, opts: PeakOptions, out: &std::path::
             eprintln!("  test {id}: {e}");
         }
     }
-    Ok(res)
+    res
 }
 
 pub fn exit_code(res: &CampaignResult) -> ExitCode {

@@ -19,12 +19,24 @@ use plots::{Panel, Series};
 /// SVG texts of the plots of one test: (id, motion, ratios).
 pub type TestSvgs = Vec<(String, String, String)>;
 
+/// What a later step (the calibration) adds to the reduce outputs: keys of
+/// summary.json and sections of report.html.
+#[derive(Debug, Default)]
+pub struct Extras {
+    pub summary: serde_json::Map<String, serde_json::Value>,
+    pub html_sections: Vec<String>,
+}
+
 /// Write everything `reduce` produces into `out`: summary.json, tables (CSV,
 /// Markdown, LaTeX), per-test plots (PNG and SVG) unless `with_plots` is false, and
-/// the self-contained report.html. Returns the plots' SVG texts.
-pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) -> Result<TestSvgs> {
+/// the self-contained report.html, with what `extra` adds.
+pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool, extra: &Extras) -> Result<()> {
     std::fs::create_dir_all(out)?;
-    let json = serde_json::to_vec_pretty(&summary::summary(res))?;
+    let mut doc = summary::summary(res);
+    if let Some(map) = doc.as_object_mut() {
+        map.extend(extra.summary.clone());
+    }
+    let json = serde_json::to_vec_pretty(&doc)?;
     write_atomic(&out.join("summary.json"), &json)?;
     let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
     let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
@@ -52,9 +64,9 @@ pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool) 
             .map(|(id, r)| test_plots(&dir, id, r, res.campaign.e_housner).map(|(m, q)| (id.to_string(), m, q)))
             .collect::<Result<Vec<_>>>()?;
     }
-    let page = html::reduce_page(res, &tabs, &svgs, &[]);
+    let page = html::reduce_page(res, &tabs, &svgs, &extra.html_sections);
     write_atomic(&out.join("report.html"), page.as_bytes())?;
-    Ok(svgs)
+    Ok(())
 }
 
 /// Paper Fig. 3/4 (displacement and velocity with the peaks) and Fig. 5 (local

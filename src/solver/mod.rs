@@ -16,4 +16,4 @@ pub mod run;
 
 pub use block::Block;
 pub use model::{Ground, Restraint, RockingModel, TieRod};
-pub use run::{simulate, simulate_at, Event, Outcome, Settings, Simulation, Stop};
+pub use run::{simulate, simulate_at, Event, Settings, Simulation, Stop};

@@ -95,9 +95,6 @@ pub struct Simulation {
     pub steps: usize,
 }
 
-/// Alias kept for readers of the issue: the outcome of a run.
-pub type Outcome = Simulation;
-
 enum Phase {
     Rest,
     Rocking(f64),
@@ -141,12 +138,11 @@ pub fn simulate_at(
     let th0 = initial.map_or(0.0, |s| s[0]);
     out.fill(t0, |_| th0);
     let sim = simulate_inner(model, ground, t0, initial, settings, &mut out);
-    let last = sim.history.last().map_or(th0, |s| s.theta);
-    let last = if settings.keep_history { last } else { f64::NAN };
-    let fill_value = if last.is_nan() {
-        out.values.last().copied().unwrap_or(th0)
-    } else {
-        last
+    // After the run: its final θ (known from the history when kept), else the last
+    // value output.
+    let fill_value = match sim.history.last() {
+        Some(s) => s.theta,
+        None => out.values.last().copied().unwrap_or(th0),
     };
     out.fill(f64::INFINITY, |_| fill_value);
     (sim, out.values)

@@ -26,7 +26,9 @@ pub struct FitResult {
     pub residuals: Vec<f64>,
     pub iterations: usize,
     pub stop: FitStop,
-    /// Covariance of q: s² (JᵀJ)⁻¹ with s² = cost / (n − p); None if singular.
+    /// Covariance of q: s² (JᵀJ)⁻¹ with s² = cost / (n − p); the pseudo-inverse
+    /// when JᵀJ is singular (a parameter the data do not see gets no variance
+    /// instead of poisoning the others with NaN); None if even that fails.
     pub covariance: Option<DMatrix<f64>>,
 }
 
@@ -113,7 +115,7 @@ pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals
     }
     let jac = jacobian(&q, &r);
     let dof = n.saturating_sub(np).max(1) as f64;
-    let covariance = jac.tr_mul(&jac).try_inverse().map(|m| m * (cost / dof));
+    let covariance = covariance(jac.tr_mul(&jac)).map(|m| m * (cost / dof));
     Some(FitResult {
         q,
         cost,
@@ -122,6 +124,17 @@ pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals
         stop,
         covariance,
     })
+}
+
+/// (JᵀJ)⁻¹, or its pseudo-inverse (singular values below 10⁻¹² of the largest
+/// dropped) when the inverse is singular or not finite.
+fn covariance(jtj: DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let finite = |m: &DMatrix<f64>| m.iter().all(|v| v.is_finite());
+    if let Some(inv) = jtj.clone().try_inverse().filter(finite) {
+        return Some(inv);
+    }
+    let scale = jtj.diagonal().iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    jtj.pseudo_inverse(1e-12 * scale.max(1e-300)).ok().filter(finite)
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ pub mod restitution;
 pub mod signal;
 pub mod solver;
 pub mod study;
+pub mod synth;
 pub mod tables;
 pub mod wall;
 

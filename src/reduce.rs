@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::{LogData, LogReader};
 use crate::peaks::{analyse, Analysis, PeakOptions, Physics};
-use crate::restitution::{coefficients, Coefficients};
+use crate::restitution::{coefficients, uncertainties, Coefficients};
 use crate::tables::{campaign_means, CampaignMeans, Row};
 
 /// A reduced test.
@@ -16,6 +16,19 @@ pub struct Reduced {
     pub log: LogData,
     pub analysis: Analysis,
     pub coefficients: Coefficients,
+    /// Standard uncertainty of every value (propagated from the peaks' covariance;
+    /// default estimator only).
+    pub uncertainty: Option<Coefficients>,
+}
+
+impl Reduced {
+    /// Why the tool cannot vouch for this test's numbers, if it cannot.
+    pub fn suspect_reason(&self) -> Option<String> {
+        match &self.analysis.quality {
+            crate::peaks::Quality::Ok => None,
+            crate::peaks::Quality::Suspect(r) => Some(r.join("; ")),
+        }
+    }
 }
 
 /// The outcome of one test.
@@ -82,10 +95,15 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
         .and_then(|analysis| {
             let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
             let c = coefficients(&v, campaign.e_housner).ok_or_else(|| format!("{file}: too few peaks (n = {} < 6)", v.len()))?;
+            let u = analysis
+                .peak_covariance
+                .as_ref()
+                .and_then(|cov| uncertainties(&v, cov, campaign.e_housner));
             Ok(Reduced {
                 log,
                 analysis,
                 coefficients: c,
+                uncertainty: u,
             })
         });
     TestOutcome {
@@ -117,6 +135,7 @@ pub fn reduce_campaign_with(campaign: Campaign, options: PeakOptions, tick: &(dy
             id: t.spec.id.clone(),
             exclude_from_mean: t.spec.exclude_from_mean,
             coefficients: t.result.as_ref().ok().map(|r| r.coefficients),
+            suspect: t.result.as_ref().ok().and_then(|r| r.suspect_reason()),
         })
         .collect();
     let means = campaign_means(&rows);

@@ -64,9 +64,90 @@ pub fn coefficients(v: &[f64], e_h: f64) -> Option<Coefficients> {
     })
 }
 
+impl Coefficients {
+    /// The ten quantities in a fixed order (e, e⁺, e⁻, r, r⁺, r⁻, r₁, r₁⁺, r₁⁻, r₂).
+    pub fn to_array(&self) -> [f64; 10] {
+        [
+            self.e,
+            self.e_plus,
+            self.e_minus,
+            self.r,
+            self.r_plus,
+            self.r_minus,
+            self.r1,
+            self.r1_plus,
+            self.r1_minus,
+            self.r2,
+        ]
+    }
+    fn from_array(a: [f64; 10]) -> Coefficients {
+        Coefficients {
+            e: a[0],
+            e_plus: a[1],
+            e_minus: a[2],
+            r: a[3],
+            r_plus: a[4],
+            r_minus: a[5],
+            r1: a[6],
+            r1_plus: a[7],
+            r1_minus: a[8],
+            r2: a[9],
+        }
+    }
+}
+
+/// Standard uncertainty of every quantity, propagated to first order from the
+/// covariance Σ_v of the first six peaks: u_q² = ∇q Σ_v ∇qᵀ, with ∇q by central
+/// differences (step 10⁻⁶ |v_k|). The peaks of one fit are correlated (they share
+/// the impact times), so the full covariance is used, not the diagonal.
+pub fn uncertainties(v: &[f64], cov: &[Vec<f64>], e_h: f64) -> Option<Coefficients> {
+    if v.len() < 6 || cov.len() < 6 {
+        return None;
+    }
+    let mut grad = [[0.0; 6]; 10];
+    for k in 0..6 {
+        let h = 1e-6 * v[k].abs().max(1e-9);
+        let mut up = v[..6].to_vec();
+        let mut dn = v[..6].to_vec();
+        up[k] += h;
+        dn[k] -= h;
+        let (a, b) = (coefficients(&up, e_h)?.to_array(), coefficients(&dn, e_h)?.to_array());
+        for q in 0..10 {
+            grad[q][k] = (a[q] - b[q]) / (2.0 * h);
+        }
+    }
+    let mut out = [0.0; 10];
+    for q in 0..10 {
+        let mut s = 0.0;
+        for i in 0..6 {
+            for j in 0..6 {
+                s += grad[q][i] * cov[i][j] * grad[q][j];
+            }
+        }
+        out[q] = s.max(0.0).sqrt();
+    }
+    out.iter().all(|u| u.is_finite()).then(|| Coefficients::from_array(out))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// r₁ = |v_1/v_0| / e_H with independent peaks: u(r₁)/r₁ = √((u0/v0)² + (u1/v1)²).
+    #[test]
+    fn uncertainty_of_r1_by_hand() {
+        let v = [-100.0, 50.0, -40.0, 30.0, -20.0, 12.0];
+        let u = [1.0, 0.5, 0.4, 0.3, 0.2, 0.1];
+        let cov: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| if i == j { u[i] * u[i] } else { 0.0 }).collect()).collect();
+        let c = coefficients(&v, 0.9).unwrap();
+        let uc = uncertainties(&v, &cov, 0.9).unwrap();
+        let want = c.r1 * ((0.01f64).powi(2) + (0.01f64).powi(2)).sqrt();
+        assert!((uc.r1 - want).abs() < 1e-6 * want, "{} {want}", uc.r1);
+        // Fully correlated relative errors (a common scale) cancel in every ratio.
+        let cov: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| 0.01 * v[i] * 0.01 * v[j]).collect()).collect();
+        let uc = uncertainties(&v, &cov, 0.9).unwrap();
+        assert!(uc.to_array().iter().all(|u| *u < 1e-6), "{uc:?}");
+    }
 
     #[test]
     fn hand_computed_sequence() {

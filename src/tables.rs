@@ -9,6 +9,9 @@ pub struct Row {
     pub id: String,
     pub exclude_from_mean: bool,
     pub coefficients: Option<Coefficients>,
+    /// Why the estimator cannot vouch for the values (a suspect test is left out
+    /// of the means).
+    pub suspect: Option<String>,
 }
 
 /// Campaign means of the ratios.
@@ -27,6 +30,10 @@ pub struct Means {
 #[derive(Debug, Clone)]
 pub struct CampaignMeans {
     pub means: Option<Means>,
+    /// Standard uncertainty of each mean from the test-to-test scatter, s/√N
+    /// (N ≥ 2 included tests): it holds the measurement noise and the real
+    /// differences between tests.
+    pub means_u: Option<Means>,
     pub included: Vec<String>,
     /// (id, why) of every test left out.
     pub left_out: Vec<(String, String)>,
@@ -43,6 +50,9 @@ impl CampaignMeans {
     }
 }
 
+/// A statistic of one quantity over the included tests (its mean, its standard error).
+type Statistic<'a> = dyn Fn(&dyn Fn(&Coefficients) -> f64) -> f64 + 'a;
+
 pub fn campaign_means(rows: &[Row]) -> CampaignMeans {
     let mut included = Vec::new();
     let mut left_out = Vec::new();
@@ -51,25 +61,36 @@ pub fn campaign_means(rows: &[Row]) -> CampaignMeans {
         match (&row.coefficients, row.exclude_from_mean) {
             (_, true) => left_out.push((row.id.clone(), "exclude_from_mean".into())),
             (None, false) => left_out.push((row.id.clone(), "not reduced".into())),
+            (Some(_), false) if row.suspect.is_some() => left_out.push((row.id.clone(), "suspect".into())),
             (Some(c), false) => {
                 included.push(row.id.clone());
                 vals.push(*c);
             }
         }
     }
-    let means = (!vals.is_empty()).then(|| {
-        let m = |f: fn(&Coefficients) -> f64| vals.iter().map(f).sum::<f64>() / vals.len() as f64;
-        Means {
-            r: m(|c| c.r),
-            r_plus: m(|c| c.r_plus),
-            r_minus: m(|c| c.r_minus),
-            r1: m(|c| c.r1),
-            r1_plus: m(|c| c.r1_plus),
-            r1_minus: m(|c| c.r1_minus),
-            r2: m(|c| c.r2),
-        }
-    });
-    CampaignMeans { means, included, left_out }
+    let n = vals.len() as f64;
+    let mean_of = |f: &dyn Fn(&Coefficients) -> f64| vals.iter().map(f).sum::<f64>() / n;
+    let sem_of = |f: &dyn Fn(&Coefficients) -> f64| {
+        let m = mean_of(f);
+        (vals.iter().map(|c| (f(c) - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+    };
+    let build = |g: &Statistic| Means {
+        r: g(&|c| c.r),
+        r_plus: g(&|c| c.r_plus),
+        r_minus: g(&|c| c.r_minus),
+        r1: g(&|c| c.r1),
+        r1_plus: g(&|c| c.r1_plus),
+        r1_minus: g(&|c| c.r1_minus),
+        r2: g(&|c| c.r2),
+    };
+    let means = (!vals.is_empty()).then(|| build(&mean_of));
+    let means_u = (vals.len() >= 2).then(|| build(&sem_of));
+    CampaignMeans {
+        means,
+        means_u,
+        included,
+        left_out,
+    }
 }
 
 #[cfg(test)]
@@ -92,7 +113,18 @@ mod tests {
                 r1_minus: 0.0,
                 r2: 0.0,
             }),
+            suspect: None,
         }
+    }
+
+    /// A suspect test is left out of the means and named with the reason.
+    #[test]
+    fn suspect_tests_are_left_out() {
+        let mut bad = row("150_3", 9.0, 9.0, 9.0, false);
+        bad.suspect = Some("the fit merged two impacts".into());
+        let m = campaign_means(&[row("150_1", 0.6, 0.5, 0.55, false), bad]);
+        assert_eq!(m.means.unwrap().r_plus, 0.6);
+        assert_eq!(m.left_out, vec![("150_3".to_string(), "suspect".to_string())]);
     }
 
     #[test]

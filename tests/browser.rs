@@ -113,7 +113,8 @@ fn reports_render_tables_and_every_plot() {
             for t in s["tests"].as_array().unwrap() {
                 let id = t["id"].as_str().unwrap();
                 for (table, col) in [("table1", "r_plus"), ("table1", "r_minus"), ("table1", "r"), ("table3", "r1")] {
-                    let expected = format!("{:.0}%", 100.0 * t[col].as_f64().unwrap());
+                    let u = t[format!("{col}_u")].as_f64();
+                    let expected = rocklab::report::tables::percent_u(t[col].as_f64().unwrap(), u);
                     assert_eq!(
                         cell(&dom, table, id, col).as_deref(),
                         Some(expected.as_str()),

@@ -56,6 +56,11 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
     if !res.means.left_out.is_empty() {
         say(&format!("means leave out: {}", res.means.left_out_text()));
     }
+    for t in &res.tests {
+        if let Some(why) = t.result.as_ref().ok().and_then(|r| r.suspect_reason()) {
+            eprintln!("suspect: test {}: {why} (its values are printed but left out of the means)", t.spec.id);
+        }
+    }
     let failed: Vec<_> = res.failed().collect();
     if !failed.is_empty() {
         eprintln!("{} of {} tests failed:", failed.len(), res.tests.len());

@@ -15,16 +15,21 @@ pub fn summary(res: &CampaignResult) -> Value {
             m.insert("id".into(), json!(t.spec.id));
             match &t.result {
                 Ok(r) => {
-                    m.insert("status".into(), json!("ok"));
-                    m.insert(
-                        "peaks".into(),
-                        json!(r
-                            .analysis
-                            .peaks
-                            .iter()
-                            .map(|p| json!({"time_s": p.time_s, "velocity_mm_s": p.velocity_mm_s}))
-                            .collect::<Vec<_>>()),
-                    );
+                    match r.suspect_reason() {
+                        None => m.insert("status".into(), json!("ok")),
+                        Some(why) => {
+                            m.insert("status".into(), json!("suspect"));
+                            m.insert("reason".into(), json!(why))
+                        }
+                    };
+                    m.insert("peaks".into(), json!(r.analysis.peaks));
+                    m.insert("contact_phases".into(), json!(r.analysis.contact_phases));
+                    if let Some(u) = &r.uncertainty {
+                        let names = ["e", "e_plus", "e_minus", "r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
+                        for (k, v) in names.iter().zip(u.to_array()) {
+                            m.insert(format!("{k}_u"), json!(v));
+                        }
+                    }
                     let q = &r.coefficients;
                     for (k, v) in [
                         ("e", q.e),
@@ -59,6 +64,7 @@ pub fn summary(res: &CampaignResult) -> Value {
         json!({"r": m.r, "r_plus": m.r_plus, "r_minus": m.r_minus, "r1": m.r1,
                "r1_plus": m.r1_plus, "r1_minus": m.r1_minus, "r2": m.r2})
     });
+    let mean_u = res.means.means_u.map(|m| serde_json::to_value(m).unwrap_or(Value::Null));
     json!({
         "campaign": c.name,
         "rocking": c.rocking.as_str(),
@@ -69,6 +75,7 @@ pub fn summary(res: &CampaignResult) -> Value {
         "method": res.options.method.describe(),
         "tests": tests,
         "mean": mean.unwrap_or(Value::Null),
+        "mean_u": mean_u.unwrap_or(Value::Null),
         "mean_included": res.means.included,
         "mean_left_out": res.means.left_out.iter().map(|(id, why)| json!({"id": id, "why": why})).collect::<Vec<_>>(),
     })

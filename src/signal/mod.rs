@@ -20,26 +20,51 @@ pub fn median(values: &[f64]) -> f64 {
     }
 }
 
-/// Robust standard deviation of white measurement noise from first differences:
-/// σ = 1.4826 · MAD(Δx) / √2. Motion occupies a small part of a free-vibration log
-/// (most of it is the static hold and the final rest), so the median ignores it.
-/// Floored at a third of the smallest non-zero step (quantisation).
+/// Robust standard deviation of white measurement noise from third differences:
+/// σ = 1.4826 · MAD(Δ³x) / √20 (Δ³x = x_{i+2} − 3x_{i+1} + 3x_i − x_{i−1} has
+/// variance 20σ²). Third differences cancel the motion to O(x⁽³⁾ Δt³), so even a
+/// log that rocks for most of its length (two-sided, e ≈ 0.95, or 100 Hz) gives
+/// the noise, not the motion (first differences overestimated σ twenty-fold
+/// there: issue #9). Impacts and spikes touch a few differences, which the median
+/// ignores. Floored at a third of the smallest non-zero step (quantisation).
 pub fn noise_sigma(x: &[f64]) -> f64 {
-    if x.len() < 3 {
+    if x.len() < 4 {
         return 0.0;
     }
-    let d: Vec<f64> = x.windows(2).map(|w| w[1] - w[0]).collect();
-    let m = median(&d);
-    let dev: Vec<f64> = d.iter().map(|v| (v - m).abs()).collect();
+    let d2: Vec<f64> = x.windows(4).map(|w| w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]).collect();
+    let m = median(&d2);
+    let dev: Vec<f64> = d2.iter().map(|v| (v - m).abs()).collect();
     let mad = median(&dev);
-    let min_step = d.iter().map(|v| v.abs()).filter(|v| *v > 0.0).fold(f64::INFINITY, f64::min);
+    let min_step = x
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
     let floor = if min_step.is_finite() { min_step / 3.0 } else { 0.0 };
-    (1.4826 * mad / std::f64::consts::SQRT_2).max(floor)
+    (1.4826 * mad / 20f64.sqrt()).max(floor)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn noise_of_a_moving_signal_is_the_noise() {
+        // A sine (amplitude 500 mm, 0.02 rad per sample) plus uniform noise of σ = 0.05:
+        // first differences would see the motion; second differences see σ.
+        let mut state = 7u64;
+        let x: Vec<f64> = (0..4000)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let u = (state >> 11) as f64 / (1u64 << 53) as f64;
+                500.0 * (0.02 * i as f64).sin() + 0.05 * (u - 0.5) * 12f64.sqrt()
+            })
+            .collect();
+        let s = noise_sigma(&x);
+        assert!((s - 0.05).abs() < 0.01, "{s}");
+    }
 
     #[test]
     fn median_odd_even() {

@@ -1,0 +1,616 @@
+//! The global free-rocking model of a log and its fit (see the docs of
+//! [`crate::peaks`] for the derivation).
+//!
+//! A record is a chain of arcs, one per half-cycle, each the closed-form
+//! small-angle solution of paper Eq. 1 (no ground motion) that starts and ends at
+//! θ = 0. Two extensions make it hold on real walls (issue #9):
+//! - **lossy inward arcs** (one-sided): the transverse walls absorb energy, so the
+//!   inward arc solves y'' = A p² − λ y − 2γ y' (a spring–dashpot restraint,
+//!   y = L θ): the wall leaves it slower than it entered; γ = 0 is the lossless
+//!   spring of the idealised model;
+//! - **contact phases**: impacts may take time. Arc k ends at the onset of
+//!   contact t_k − u, arc k+1 starts at t_k + δ + w, and in between the
+//!   displacement is the cubic Hermite interpolant of the two arcs (value and
+//!   slope at both ends). The lead u, the lag w and the shift δ between the two
+//!   arcs' zeros are one set per test. Without them (u = w = δ = 0) the impacts
+//!   are instantaneous.
+//!   The peak v_k is the slope of arc k at the onset of contact: the end of the
+//!   free arc, where the wall is fastest (SPEC: the extreme of the velocity in
+//!   the half-cycle).
+//!
+//! Parameters live in one vector; [`Layout`] names every position.
+
+use crate::fit::{levenberg_marquardt, FitResult};
+
+/// Names of the positions in the parameter vector. Rates and lengths are stored
+/// as logarithms so that they stay positive; λ and γ are signed.
+pub(crate) mod ix {
+    /// Sensor zero z (mm, in L θ space).
+    pub const ZERO: usize = 0;
+    /// Sensor drift (mm/s): fixed by the final rest line.
+    pub const DRIFT: usize = 1;
+    /// ln A of the small arcs, A = L tan α_e (mm).
+    pub const LN_A: usize = 2;
+    /// ln p of the small arcs: kept equal to ln p0 (short arcs only see A p²).
+    pub const LN_P: usize = 3;
+    /// λ = κ − p² of the inward arcs of one-sided rocking (s⁻²).
+    pub const LAMBDA: usize = 4;
+    /// ln A0 and ln p0 of the release arc.
+    pub const LN_A0: usize = 5;
+    pub const LN_P0: usize = 6;
+    /// Release time t_r (s).
+    pub const T_R: usize = 7;
+    /// Decay rate γ of the inward arcs of one-sided rocking (s⁻¹).
+    pub const GAMMA: usize = 8;
+    /// Impact k's zero time t_k sits at IMPACT0 + k.
+    pub const IMPACT0: usize = 9;
+}
+
+/// How many impacts the vector holds, whether it carries contact phases and
+/// whether they differ by direction (one-sided rocking: entering the inward side
+/// meets the transverse walls)
+/// (then δ, ln u and ln w follow the impact times, one set for the impacts that
+/// enter the inward side and one for those that enter the outward side: one
+/// contact shape per direction, not per impact, so that the contact cannot absorb
+/// what the arcs must explain, and the peaks of one side share their bias,
+/// which cancels in the ratios).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layout {
+    pub impacts: usize,
+    pub contacts: bool,
+    pub by_direction: bool,
+}
+
+impl Layout {
+    /// Length of the parameter vector.
+    pub fn size(&self) -> usize {
+        ix::IMPACT0
+            + self.impacts
+            + if !self.contacts {
+                0
+            } else if self.by_direction {
+                6
+            } else {
+                3
+            }
+    }
+    /// Position of δ, ln u (lead) and ln w (lag) of impact k (k even enters the
+    /// inward side).
+    pub fn delta(&self, k: usize) -> usize {
+        ix::IMPACT0 + self.impacts + if self.by_direction { 3 * (k % 2) } else { 0 }
+    }
+    pub fn lead(&self, k: usize) -> usize {
+        self.delta(k) + 1
+    }
+    pub fn lag(&self, k: usize) -> usize {
+        self.delta(k) + 2
+    }
+}
+
+/// Which piece of the model owns a time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Piece {
+    /// Free arc s: the release arc for s = 0, then the arc between impacts s−1, s.
+    Arc(usize),
+    /// Contact phase of impact k.
+    Contact(usize),
+}
+
+/// The global model: layout, parameters and the shortest arc allowed (s).
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub one_sided: bool,
+    pub layout: Layout,
+    /// Reference time of the drift line.
+    pub t_ref: f64,
+    /// Shortest arc or contact window the fit may produce (half a sample): two
+    /// impacts never collapse onto one instant.
+    pub min_len: f64,
+    pub q: Vec<f64>,
+}
+
+impl Model {
+    pub fn m(&self) -> usize {
+        self.layout.impacts
+    }
+    pub fn impact(&self, k: usize) -> f64 {
+        self.q[ix::IMPACT0 + k]
+    }
+    fn delta(&self, k: usize) -> f64 {
+        if self.layout.contacts {
+            self.q[self.layout.delta(k)]
+        } else {
+            0.0
+        }
+    }
+    fn lead(&self, k: usize) -> f64 {
+        if self.layout.contacts {
+            self.q[self.layout.lead(k)].exp()
+        } else {
+            0.0
+        }
+    }
+    fn lag(&self, k: usize) -> f64 {
+        if self.layout.contacts {
+            self.q[self.layout.lag(k)].exp()
+        } else {
+            0.0
+        }
+    }
+    /// Lead and lag of the contact phases (s) entering the inward side and
+    /// entering the outward side, when the model has them.
+    pub fn contact_windows(&self) -> Option<[(f64, f64); 2]> {
+        self.layout.contacts.then(|| [(self.lead(0), self.lag(0)), (self.lead(1), self.lag(1))])
+    }
+    pub fn release_time(&self) -> f64 {
+        self.q[ix::T_R]
+    }
+    pub fn p(&self) -> f64 {
+        self.q[ix::LN_P0].exp()
+    }
+    pub fn lambda(&self) -> Option<f64> {
+        self.one_sided.then(|| self.q[ix::LAMBDA])
+    }
+    pub fn gamma(&self) -> Option<f64> {
+        self.one_sided.then(|| self.q[ix::GAMMA])
+    }
+    /// Onset of contact of impact k (the end of free arc k).
+    pub fn onset(&self, k: usize) -> f64 {
+        self.impact(k) - self.lead(k)
+    }
+    /// End of the contact of impact k (the start of free arc k+1).
+    pub fn release_from_contact(&self, k: usize) -> f64 {
+        self.impact(k) + self.delta(k) + self.lag(k)
+    }
+    /// Length of free arc s (s ≥ 1: between its zeros; the release arc from t_r).
+    pub fn arc_length(&self, s: usize) -> f64 {
+        if s == 0 {
+            self.impact(0) - self.release_time()
+        } else {
+            let (a, b) = self.zeros(s);
+            b - a
+        }
+    }
+    /// Zeros (start, end) of free arc s ≥ 1.
+    fn zeros(&self, s: usize) -> (f64, f64) {
+        (self.impact(s - 1) + self.delta(s - 1), self.impact(s))
+    }
+    fn zero_line(&self, t: f64) -> f64 {
+        self.q[ix::ZERO] + self.q[ix::DRIFT] * (t - self.t_ref)
+    }
+
+    /// Strictly ordered pieces, each at least `min_len` long (or empty), finite values.
+    pub fn valid(&self) -> bool {
+        if !self.q.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        let mut prev = self.release_time();
+        for k in 0..self.m() {
+            let on = self.onset(k);
+            if on - prev < self.min_len {
+                return false;
+            }
+            if k >= 1 {
+                let (a, b) = self.zeros(k);
+                if b - a < self.min_len {
+                    return false;
+                }
+            }
+            prev = if k + 1 < self.m() { self.release_from_contact(k) } else { on };
+            if prev < on {
+                return false;
+            }
+        }
+        let under_damped = self.q[ix::LAMBDA] - self.q[ix::GAMMA].powi(2);
+        if self.one_sided && under_damped > 0.0 {
+            // The inward arc must stay below half a period (ω T < π, ω² = λ − γ²),
+            // so that it has no zero inside.
+            let w = under_damped.sqrt();
+            for s in (1..self.m()).step_by(2) {
+                let (a, b) = self.zeros(s);
+                if w * (b - a) >= std::f64::consts::PI {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// The piece owning t; None past the last impact's onset.
+    fn owner(&self, t: f64) -> Option<Piece> {
+        let m = self.m();
+        for k in 0..m {
+            if t < self.onset(k) {
+                return Some(Piece::Arc(k));
+            }
+            if k + 1 < m && t < self.release_from_contact(k) {
+                return Some(Piece::Contact(k));
+            }
+        }
+        None
+    }
+
+    /// L θ of free arc s at t and its time derivative (the zero line excluded).
+    ///
+    /// - release arc (s = 0): L θ = A0 (1 − cosh(p0 (t − t_r)) / cosh(p0 (t_0 − t_r)))
+    ///   after the release, constant before it (the wall is held);
+    /// - gravity side (outward; inward in two-sided rocking, with −A):
+    ///   L θ = ±A (1 − cosh(p (t − t_m)) / cosh(p T/2)), T the arc's length;
+    /// - inward side of one-sided rocking: the damped spring arc of [`damped_arc`],
+    ///   y'' = A p² − λ y − 2γ y' between its two zeros.
+    pub fn arc(&self, s: usize, t: f64) -> (f64, f64) {
+        if s == 0 {
+            let (a0, p0, tr, t0) = (self.q[ix::LN_A0].exp(), self.p(), self.release_time(), self.impact(0));
+            let c = (p0 * (t0 - tr)).cosh();
+            let tau = (t - tr).max(0.0);
+            return (a0 * (1.0 - (p0 * tau).cosh() / c), -a0 * p0 * (p0 * tau).sinh() / c);
+        }
+        let (ta, tb) = self.zeros(s);
+        let (tm, half) = (0.5 * (ta + tb), 0.5 * (tb - ta));
+        let tau = t - tm;
+        let a = self.q[ix::LN_A].exp();
+        // p of the short arcs is tied to the release arc's: they only see the
+        // gravity term A p² (their curvature at θ = 0), so p and A are not
+        // separable there.
+        let p = self.p();
+        let inward = s % 2 == 1;
+        if inward && self.one_sided {
+            damped_arc(self.q[ix::LAMBDA], self.q[ix::GAMMA], a * p * p, t - ta, tb - ta)
+        } else {
+            let sign = if inward { -1.0 } else { 1.0 };
+            let den = (p * half).cosh();
+            (sign * a * (1.0 - (p * tau).cosh() / den), -sign * a * p * (p * tau).sinh() / den)
+        }
+    }
+
+    /// The contact phase of impact k: cubic Hermite between arc k at its onset and
+    /// arc k+1 at the end of the contact.
+    fn contact(&self, k: usize, t: f64) -> (f64, f64) {
+        let (t0, t1) = (self.onset(k), self.release_from_contact(k));
+        let (y0, v0) = self.arc(k, t0);
+        let (y1, v1) = self.arc(k + 1, t1);
+        let h = t1 - t0;
+        let s = (t - t0) / h;
+        let (s2, s3) = (s * s, s * s * s);
+        let y = (2.0 * s3 - 3.0 * s2 + 1.0) * y0 + (s3 - 2.0 * s2 + s) * h * v0 + (3.0 * s2 - 2.0 * s3) * y1 + (s3 - s2) * h * v1;
+        let v = (6.0 * s2 - 6.0 * s) * (y0 - y1) / h + (3.0 * s2 - 4.0 * s + 1.0) * v0 + (3.0 * s2 - 2.0 * s) * v1;
+        (y, v)
+    }
+
+    /// Modelled reading at t (L θ space) and its slope.
+    pub fn eval(&self, t: f64) -> Option<(f64, f64)> {
+        let (f, df) = match self.owner(t)? {
+            Piece::Arc(s) => self.arc(s, t),
+            Piece::Contact(k) => self.contact(k, t),
+        };
+        Some((self.zero_line(t) + f, df + self.q[ix::DRIFT]))
+    }
+
+    /// Residuals y − model; false when the parameters are not a valid model.
+    pub fn residuals(&self, t: &[f64], y: &[f64], out: &mut Vec<f64>) -> bool {
+        out.clear();
+        if !self.valid() {
+            return false;
+        }
+        out.extend(t.iter().zip(y).map(|(ti, yi)| self.eval(*ti).map_or(0.0, |(m, _)| yi - m)));
+        true
+    }
+
+    /// Velocity (mm/s) at the onset of impact k (= v_k) and just after its contact.
+    pub fn speeds(&self, k: usize) -> (f64, Option<f64>) {
+        let drift = self.q[ix::DRIFT];
+        let before = self.arc(k, self.onset(k)).1 + drift;
+        let after = (k + 1 < self.m()).then(|| self.arc(k + 1, self.release_from_contact(k)).1 + drift);
+        (before, after)
+    }
+
+    /// The velocity peak v_k of half-cycle k (SPEC): the extreme of the model's
+    /// velocity, with the sign of the motion towards impact k, from the last
+    /// quarter of free arc k through the contact phase up to the model's zero
+    /// crossing. With instantaneous impacts this is the arc's slope at t_k (a
+    /// gravity arc is fastest at its end); with a contact phase the peak may fall
+    /// inside it, before the crossing; on a lossy inward arc it may come before
+    /// the arc's end. Returns (time, velocity mm/s).
+    pub fn peak(&self, k: usize) -> (f64, f64) {
+        let (v_end_t, v_end) = (self.onset(k), self.arc(k, self.onset(k)).1);
+        let start = if k == 0 { self.release_time() } else { self.release_from_contact(k - 1) };
+        let from = v_end_t - 0.25 * (v_end_t - start);
+        let to = if k + 1 < self.m() { self.release_from_contact(k) } else { v_end_t };
+        let want = if k % 2 == 0 { -1.0 } else { 1.0 };
+        // Half-cycle k lies on the outward side for k even.
+        let side = -want;
+        let mut best = (v_end_t, v_end);
+        const N: usize = 400;
+        for i in 0..=N {
+            let t = from + (to - from) * i as f64 / N as f64;
+            // Arc k up to its end, then the contact phase (never arc k+1: its
+            // start speed is the speed after the impact).
+            let (y, v) = if t <= v_end_t { self.arc(k, t) } else { self.contact(k, t) };
+            if side * y < 0.0 {
+                break;
+            }
+            if want * v > want * best.1 {
+                best = (t, v);
+            }
+        }
+        (best.0, best.1 + self.q[ix::DRIFT])
+    }
+
+    /// The same model with contact phases (δ = 0, lead = lag = `window` s).
+    pub fn with_contacts(&self, window: f64) -> Model {
+        let layout = Layout {
+            impacts: self.m(),
+            contacts: true,
+            by_direction: self.one_sided,
+        };
+        let mut q = self.q[..ix::IMPACT0 + self.m()].to_vec();
+        q.extend_from_slice(&[0.0, window.ln(), window.ln()]);
+        if layout.by_direction {
+            q.extend_from_slice(&[0.0, window.ln(), window.ln()]);
+        }
+        Model { layout, q, ..self.clone() }
+    }
+
+    /// Which parameters a fit frees: all but p (tied to p0), the drift (fixed by
+    /// the final rest line), and λ and γ in two-sided rocking.
+    pub fn free(&self) -> Vec<usize> {
+        (0..self.q.len())
+            .filter(|&j| j != ix::LN_P && j != ix::DRIFT)
+            .filter(|&j| self.one_sided || (j != ix::LAMBDA && j != ix::GAMMA))
+            .collect()
+    }
+}
+
+/// The inward arc of one-sided rocking with a lossy restraint: the solution of
+/// y'' = F − λ y − 2γ y' with y(0) = y(T) = 0, at τ ∈ [0, T] (y = L θ, F = A p²,
+/// λ = κ − p²), and its slope:
+///
+///   y = F ψ(τ) + v₀ φ₂(τ),  v₀ = −F ψ(T) / φ₂(T),
+///
+/// with φ₂ = e^{−γτ} S(τ) (φ₂(0) = 0, φ₂'(0) = 1), φ₁ = e^{−γτ} (C + γ S),
+/// ψ = (1 − φ₁)/λ the unit step response (ψ' = φ₂), C = cosh μτ and S = sinh(μτ)/μ
+/// for μ² = γ² − λ (cos and sin/ω when μ² < 0). Near λ = 0, ψ comes from its power
+/// series, (n+2)(n+1) a_{n+2} = [n = 0] − 2γ (n+1) a_{n+1} − λ a_n.
+pub fn damped_arc(lambda: f64, gamma: f64, f: f64, tau: f64, t_len: f64) -> (f64, f64) {
+    let parts = |x: f64| {
+        let mu2 = gamma * gamma - lambda;
+        let (c, s) = if (mu2 * x * x).abs() < 1e-8 {
+            (1.0 + 0.5 * mu2 * x * x, x * (1.0 + mu2 * x * x / 6.0))
+        } else if mu2 > 0.0 {
+            let m = mu2.sqrt();
+            ((m * x).cosh(), (m * x).sinh() / m)
+        } else {
+            let w = (-mu2).sqrt();
+            ((w * x).cos(), (w * x).sin() / w)
+        };
+        let e = (-gamma * x).exp();
+        let phi2 = e * s;
+        let dphi2 = e * (c - gamma * s);
+        let psi = if (lambda * t_len * t_len).abs() < 1e-2 {
+            step_response_series(lambda, gamma, x)
+        } else {
+            (1.0 - e * (c + gamma * s)) / lambda
+        };
+        (psi, phi2, dphi2)
+    };
+    let (psi_t, phi2_t, _) = parts(t_len);
+    let v0 = -f * psi_t / phi2_t;
+    let (psi, phi2, dphi2) = parts(tau);
+    (f * psi + v0 * phi2, f * phi2 + v0 * dphi2)
+}
+
+/// ψ(τ) of [`damped_arc`] by its power series (|λ| τ² small).
+fn step_response_series(lambda: f64, gamma: f64, x: f64) -> f64 {
+    let (mut a0, mut a1, mut a2) = (0.0, 0.0, 0.5);
+    let mut sum = 0.5 * x * x;
+    let mut pw = x * x;
+    for n in 1..40 {
+        // a_{n+2} from a_{n+1} (= a2) and a_n (= a1).
+        let next = (-2.0 * gamma * (n + 1) as f64 * a2 - lambda * a1) / ((n + 2) * (n + 1)) as f64;
+        pw *= x;
+        sum += next * pw;
+        a0 = a1;
+        a1 = a2;
+        a2 = next;
+        if (next * pw).abs() < 1e-17 * sum.abs() {
+            break;
+        }
+    }
+    let _ = a0;
+    sum
+}
+
+/// The inward arc of one-sided rocking between two impacts, per unit A p²:
+/// g = (cos(√λ τ) − cos(√λ h)) / (λ cos(√λ h)) with h = T/2 (so L θ = −A p² g),
+/// and dg/dτ; cosh for λ < 0 (gravity stronger than the spring) and the series
+/// (h² − τ²)/2 + λ [(h² − τ²) h²/4 − (h⁴ − τ⁴)/24] near λ = 0, so the arc is smooth
+/// in λ across 0.
+pub fn spring_arc(l: f64, tau: f64, h: f64) -> (f64, f64) {
+    if (l * h * h).abs() < 1e-4 {
+        let (h2, t2) = (h * h, tau * tau);
+        let g = 0.5 * (h2 - t2) + l * ((h2 - t2) * h2 / 4.0 - (h2 * h2 - t2 * t2) / 24.0);
+        let dg = -tau + l * (-tau * h2 / 2.0 + tau * t2 / 6.0);
+        (g, dg)
+    } else if l > 0.0 {
+        let w = l.sqrt();
+        let den = (w * h).cos();
+        (((w * tau).cos() - den) / (l * den), -(w * tau).sin() / (w * den))
+    } else {
+        let v = (-l).sqrt();
+        let den = (v * h).cosh();
+        (((v * tau).cosh() - den) / (l * den), -(v * tau).sinh() / (v * den))
+    }
+}
+
+/// A fitted model with what the fit knows of its own precision.
+#[derive(Debug, Clone)]
+pub struct Fitted {
+    pub model: Model,
+    pub fit: FitResult,
+    /// Positions of the fitted parameters in `model.q` (the order of the covariance).
+    pub free: Vec<usize>,
+}
+
+impl Fitted {
+    /// Standard uncertainty and covariance of the peak speeds v_0..v_{n−1} (mm/s),
+    /// propagated from the fit's covariance s² (JᵀJ)⁻¹ by the Jacobian of the
+    /// speeds (central differences): Σ_v = G Σ_q Gᵀ. None when JᵀJ is singular.
+    pub fn peak_covariance(&self, n: usize) -> Option<Vec<Vec<f64>>> {
+        let cov = self.fit.covariance.as_ref()?;
+        let n = n.min(self.model.m());
+        let speeds = |m: &Model| -> Vec<f64> { (0..n).map(|k| m.peak(k).1).collect() };
+        let np = self.free.len();
+        let mut g = vec![vec![0.0; np]; n];
+        for (c, &j) in self.free.iter().enumerate() {
+            let h = step_for(&self.model, j);
+            let mut up = self.model.clone();
+            up.q[j] += h;
+            let mut dn = self.model.clone();
+            dn.q[j] -= h;
+            let (a, b) = (speeds(&up), speeds(&dn));
+            for k in 0..n {
+                g[k][c] = (a[k] - b[k]) / (2.0 * h);
+            }
+        }
+        let mut out = vec![vec![0.0; n]; n];
+        for a in 0..n {
+            for b in 0..n {
+                let mut s = 0.0;
+                for i in 0..np {
+                    for j in 0..np {
+                        s += g[a][i] * cov[(i, j)] * g[b][j];
+                    }
+                }
+                out[a][b] = s;
+            }
+        }
+        Some(out)
+    }
+}
+
+/// Finite-difference step of parameter j.
+fn step_for(model: &Model, j: usize) -> f64 {
+    let l = model.layout;
+    let is_contact = l.contacts && j >= ix::IMPACT0 + l.impacts;
+    match j {
+        _ if is_contact => 1e-4,
+        _ if j >= ix::T_R && j != ix::GAMMA => 1e-6,
+        ix::LAMBDA | ix::GAMMA => 1e-6 * model.q[j].abs().max(1.0),
+        _ => 1e-7 * model.q[j].abs().max(1e-3),
+    }
+}
+
+/// Fit a [`Model`] by Levenberg–Marquardt ([`crate::fit`]) over [`Model::free`].
+pub fn fit_model(model: Model, t: &[f64], y: &[f64], max_iter: usize) -> Option<Fitted> {
+    let free = model.free();
+    let with = |qf: &[f64]| {
+        let mut m = model.clone();
+        for (k, &j) in free.iter().enumerate() {
+            m.q[j] = qf[k];
+        }
+        m
+    };
+    let resid = |qf: &[f64]| {
+        let mut r = Vec::with_capacity(t.len());
+        with(qf).residuals(t, y, &mut r).then_some(r)
+    };
+    let q0: Vec<f64> = free.iter().map(|&j| model.q[j]).collect();
+    let steps: Vec<f64> = free.iter().map(|&j| step_for(&model, j)).collect();
+    let fit = levenberg_marquardt(&q0, &steps, max_iter, &resid)?;
+    Some(Fitted {
+        model: with(&fit.q),
+        fit,
+        free,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_sided(contacts: bool) -> Model {
+        let mut q = vec![0.0, 0.0, 100f64.ln(), 2f64.ln(), 0.0, 150f64.ln(), 2f64.ln(), 0.0, 0.0];
+        q.extend_from_slice(&[0.5, 1.5, 2.4]);
+        let m = Model {
+            one_sided: false,
+            layout: Layout {
+                impacts: 3,
+                contacts: false,
+                by_direction: false,
+            },
+            t_ref: 0.0,
+            min_len: 1e-3,
+            q,
+        };
+        if contacts {
+            m.with_contacts(0.01)
+        } else {
+            m
+        }
+    }
+
+    /// The contact phase joins the arcs continuously in value and slope.
+    #[test]
+    fn contact_phase_is_continuous() {
+        let m = two_sided(true);
+        for k in 0..2 {
+            for t in [m.onset(k), m.release_from_contact(k)] {
+                let (a, va) = m.eval(t - 1e-9).unwrap();
+                let (b, vb) = m.eval(t + 1e-9).unwrap();
+                assert!((a - b).abs() < 1e-5 && (va - vb).abs() < 1e-3, "k {k} t {t}: {a} {b} {va} {vb}");
+            }
+        }
+    }
+
+    /// Without contact phases the peak is the slope at the zero; with a lead of
+    /// u it is the slope u earlier (slower on a gravity arc).
+    #[test]
+    fn peak_at_the_onset_of_contact() {
+        let m0 = two_sided(false);
+        let m1 = two_sided(true);
+        let (v0, _) = m0.speeds(1);
+        let (v1, _) = m1.speeds(1);
+        assert!((m0.arc(1, 1.5).1 - v0).abs() < 1e-12);
+        assert!(v1.abs() < v0.abs(), "{v1} {v0}");
+        assert!((m1.arc(1, 1.49).1 - v1).abs() < 1e-9);
+    }
+
+    /// The damped arc is the lossless spring arc at γ = 0, hits both zeros, solves
+    /// its equation, and leaves slower than it entered when γ > 0.
+    #[test]
+    fn damped_arc_solves_its_equation() {
+        for (l, g) in [(900.0, 0.0), (900.0, 6.0), (-3.0, 0.5), (1e-6, 2.0), (0.0, 0.0)] {
+            let (f, t_len) = (1800.0, 0.08);
+            let (y0, v0) = damped_arc(l, g, f, 0.0, t_len);
+            let (y1, v1) = damped_arc(l, g, f, t_len, t_len);
+            assert!(y0.abs() < 1e-9 && y1.abs() < 1e-9, "λ {l} γ {g}: {y0} {y1}");
+            // Residual of y'' = F − λ y − 2γ y' by central differences.
+            let h = 1e-5;
+            for tau in [0.01, 0.04, 0.07] {
+                let (ym, _) = damped_arc(l, g, f, tau - h, t_len);
+                let (y, v) = damped_arc(l, g, f, tau, t_len);
+                let (yp, _) = damped_arc(l, g, f, tau + h, t_len);
+                let ypp = (yp - 2.0 * y + ym) / (h * h);
+                let r = ypp - (f - l * y - 2.0 * g * v);
+                assert!(r.abs() < 1e-3 * f, "λ {l} γ {g} τ {tau}: residual {r}");
+            }
+            if g == 0.0 && l > 1.0 {
+                let (gg, dg) = spring_arc(l, 0.02 - 0.04, 0.04);
+                let (y, v) = damped_arc(l, g, f, 0.02, t_len);
+                assert!((y + f * gg).abs() < 1e-9 * f && (v + f * dg).abs() < 1e-7 * f);
+            }
+            if g > 0.0 {
+                assert!(v1.abs() < v0.abs(), "λ {l} γ {g}: exit {v1} entry {v0}");
+            }
+        }
+    }
+
+    /// Two impacts may not collapse onto one instant.
+    #[test]
+    fn collapsed_impacts_are_invalid() {
+        let mut m = two_sided(false);
+        assert!(m.valid());
+        m.q[ix::IMPACT0 + 1] = m.q[ix::IMPACT0] + 1e-4;
+        assert!(!m.valid());
+    }
+}

@@ -328,12 +328,14 @@ fn parse_uncertainty(path: &Path, t: &toml::Table, block: &BlockSpec) -> anyhow:
                     u.unit_stiffness_mn_m2 = d;
                 }
             }
-            other => return Err(bad(
-                path,
-                format!(
+            other => {
+                return Err(bad(
+                    path,
+                    format!(
                     "[uncertainty].{other}: unknown input (expected magnification, r_m, alpha_rad, i0_kg_m2, unit_stiffness_mn_m2, contact_height_m)"
                 ),
-            )),
+                ))
+            }
         }
     }
     Ok(u)

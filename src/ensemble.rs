@@ -72,13 +72,27 @@ impl Dist {
         }
     }
 
-    /// "0.59", "N(0.59, 0.03)", "U[1.25, 1.29]".
+    /// "0.59", "N(0.59, 0.03)", "U[1.25, 1.29]" (4 significant digits).
     pub fn describe(&self) -> String {
         match *self {
-            Dist::Fixed { value } => format!("{value}"),
-            Dist::Normal { mean, sd } => format!("N({mean}, {sd})"),
-            Dist::Uniform { lo, hi } => format!("U[{lo}, {hi}]"),
+            Dist::Fixed { value } => short(value),
+            Dist::Normal { mean, sd } => format!("N({}, {})", short(mean), short(sd)),
+            Dist::Uniform { lo, hi } => format!("U[{}, {}]", short(lo), short(hi)),
         }
+    }
+}
+
+/// A number with 4 significant digits, without trailing zeros (2.65e6 as 2650000).
+pub fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 

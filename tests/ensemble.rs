@@ -25,8 +25,8 @@ fn fixture_study() -> Study {
 /// 95 % Wilson interval.
 #[test]
 fn rectangular_pulse_probability_matches_the_draws_above_housner_threshold() {
-    let (alpha, p2, td) = (0.2, 4.0, 0.3);
-    let crit = 1.0 / (1.0 - (-(p2 as f64).sqrt() * td).exp());
+    let (alpha, p2, td): (f64, f64, f64) = (0.2, 4.0, 0.3);
+    let crit = 1.0 / (1.0 - (-(p2.sqrt()) * td).exp());
     let model = RockingModel {
         alpha,
         p2,

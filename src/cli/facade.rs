@@ -397,7 +397,7 @@ fn results_table(study: &Study, runs: &[StudyRun]) -> anyhow::Result<(Vec<u8>, S
     }
     md.push_str(&format!(
         "\nCoefficient sets: {}. Housner by Eq. 2 with α = {}: e_H = {:.3}. Ground motions ×{}. † the outcome or the peak changes when the integration tolerance is tightened or loosened 100× (a knife-edge result).\n",
-        study.sets.iter().map(|s| format!("{} (e_in {}, e_out {}, {})", s.name, s.e_in, s.e_out, s.source)).collect::<Vec<_>>().join("; "),
+        study.sets.iter().map(|s| format!("{} (e_in {}, e_out {}, {})", s.name, rocklab::ensemble::short(s.e_in), rocklab::ensemble::short(s.e_out), s.source)).collect::<Vec<_>>().join("; "),
         study.block.block.alpha,
         study.e_housner_eq2,
         study.magnification

@@ -860,8 +860,18 @@ pub fn run_ida_samples(study: &Study, scales: &[f64], n: usize, tick: &(dyn Fn()
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SetFragility {
     pub coefficients: String,
+    /// In summary.json: the fitted values, or `{"error": why}`.
+    #[serde(serialize_with = "fit_or_error")]
     pub fit: Result<Fragility, FragilityError>,
     pub observed: Vec<Trial>,
+}
+
+fn fit_or_error<S: serde::Serializer>(fit: &Result<Fragility, FragilityError>, ser: S) -> Result<S::Ok, S::Error> {
+    use serde::Serialize;
+    match fit {
+        Ok(f) => f.serialize(ser),
+        Err(e) => serde_json::json!({ "error": e.to_string() }).serialize(ser),
+    }
 }
 
 /// Fit a lognormal fragility per coefficient set to sample runs: every run is one

@@ -405,10 +405,57 @@ pub fn calibrate(res: &CampaignResult, n_impacts: usize) -> Calibration {
     }
 }
 
-/// calibration.toml (read by `simulate --calibration` and the façade study).
+/// What an uncertainty ensemble needs from a calibration: the spread of the
+/// per-test fits over the included tests and the fits' own standard errors.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Spread {
+    pub n_tests: usize,
+    /// Test-to-test sample standard deviation (n − 1) of the per-test e_in, e_out
+    /// (0 with one test).
+    pub sd_e_in_tests: f64,
+    pub sd_e_out_tests: f64,
+    /// Standard error of the means: sd / √n.
+    pub se_e_in_mean: f64,
+    pub se_e_out_mean: f64,
+    /// Root mean square of the per-test fits' standard errors.
+    pub se_e_in_fit: f64,
+    pub se_e_out_fit: f64,
+}
+
+/// The spread of the included per-test fits.
+pub fn spread(c: &Calibration) -> Spread {
+    let inc: Vec<&TestFit> = c.tests.iter().filter(|t| c.included.contains(&t.id)).collect();
+    let n = inc.len();
+    let sd = |f: fn(&TestFit) -> f64| {
+        if n < 2 {
+            return 0.0;
+        }
+        let m = inc.iter().map(|t| f(t)).sum::<f64>() / n as f64;
+        (inc.iter().map(|t| (f(t) - m).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
+    };
+    let rms = |f: fn(&TestFit) -> f64| {
+        let v: Vec<f64> = inc.iter().map(|t| f(t)).filter(|x| x.is_finite()).collect();
+        (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+    };
+    let (si, so) = (sd(|t| t.e_in), sd(|t| t.e_out));
+    let root = (n.max(1) as f64).sqrt();
+    Spread {
+        n_tests: n,
+        sd_e_in_tests: si,
+        sd_e_out_tests: so,
+        se_e_in_mean: si / root,
+        se_e_out_mean: so / root,
+        se_e_in_fit: rms(|t| t.se_e_in),
+        se_e_out_fit: rms(|t| t.se_e_out),
+    }
+}
+
+/// calibration.toml (read by `simulate --calibration` and the façade study):
+/// the means, the spread an ensemble draws from (`[calibration.spread]`) and the
+/// joint fit.
 pub fn to_toml(c: &Calibration) -> String {
     let mut s = format!(
-        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.joint]: one fit over all of them.\n[calibration]\ncampaign = {:?}\nrocking = {:?}\ne_in = {}\ne_out = {}\nr_in = {}\nr_out = {}\ne_housner = {}\n",
+        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from); [calibration.joint]:\n# one fit over all of them.\n[calibration]\ncampaign = {:?}\nrocking = {:?}\ne_in = {}\ne_out = {}\nr_in = {}\nr_out = {}\ne_housner = {}\n",
         c.included.join(", "),
         c.campaign,
         c.rocking,
@@ -418,6 +465,18 @@ pub fn to_toml(c: &Calibration) -> String {
         c.r_out,
         c.e_housner
     );
+    let sp = spread(c);
+    s.push_str(&format!(
+        "\n[calibration.spread]\n# Each test: unweighted least squares on the displacement (mm) over the window of\n# its first impacts, nuisance parameters free (release time, zero, p² factor{}).\nweighting = \"unweighted least squares on displacement, per test\"\nn_tests = {}\nsd_e_in_tests = {}\nsd_e_out_tests = {}\nse_e_in_mean = {}\nse_e_out_mean = {}\nse_e_in_fit = {}\nse_e_out_fit = {}\n",
+        if c.rocking == "one-sided" { ", inward spring" } else { "" },
+        sp.n_tests,
+        sp.sd_e_in_tests,
+        sp.sd_e_out_tests,
+        sp.se_e_in_mean,
+        sp.se_e_out_mean,
+        sp.se_e_in_fit,
+        sp.se_e_out_fit
+    ));
     if let Some(j) = &c.joint {
         s.push_str(&format!(
             "\n[calibration.joint]\ne_in = {}\ne_out = {}\nse_e_in = {}\nse_e_out = {}\nrms_mm = {}\n",

@@ -11,9 +11,11 @@
 
 pub mod atomic;
 pub mod calibrate;
+pub mod ensemble;
 pub mod error;
 pub mod facade;
 pub mod fit;
+pub mod fragility;
 pub mod ground_motion;
 pub mod ingest;
 pub mod peaks;
@@ -22,6 +24,7 @@ pub mod report;
 pub mod restitution;
 pub mod signal;
 pub mod solver;
+pub mod stats;
 pub mod study;
 pub mod synth;
 pub mod tables;

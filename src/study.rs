@@ -64,11 +64,20 @@ pub fn ground(record: &Record, spec: &RunSpec) -> Ground {
 
 /// Run one simulation from rest at the record's first sample.
 pub fn run(block: &BlockSpec, record: &Record, spec: &RunSpec) -> (RunSummary, Simulation) {
+    run_with(block, record, spec, true)
+}
+
+/// As [`run`], choosing whether a wall at rest after the last sample that could
+/// uplift it stops the run ([`Settings::stop_at_rest`]; `run` always does).
+pub fn run_with(block: &BlockSpec, record: &Record, spec: &RunSpec, stop_at_rest: bool) -> (RunSummary, Simulation) {
     let m = model(block, spec);
     let g = ground(record, spec);
     let mut settings = Settings::new(record.t0 + record.duration() + spec.t_extra).with_tolerances(spec.rtol, spec.atol);
     if !spec.keep_history {
         settings = settings.without_history();
+    }
+    if !stop_at_rest {
+        settings = settings.without_stop_at_rest();
     }
     let start = std::time::Instant::now();
     let sim = simulate(&m, &g, record.t0, None, &settings);

@@ -61,6 +61,7 @@ fn demo(out: &Path) {
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"))
         .arg("--out")
         .arg(out)
+        .args(["--samples", "3", "--ida-samples", "1", "--scales", "0.5:1.5:3"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -126,6 +127,8 @@ fn reports_render_tables_and_every_plot() {
             assert!(dom.contains("SHA-256"), "{name}: provenance");
         } else {
             assert!(dom.contains("20161030_NRC") && dom.contains("overturns at"), "façade results table");
+            assert!(dom.contains("id=\"ensemble\"") && dom.contains("P(overturn)"), "façade P(overturn) table");
+            assert!(dom.contains("id=\"fragility\""), "façade fragility table");
         }
     }
 }

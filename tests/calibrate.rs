@@ -83,4 +83,27 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     std::fs::write(&toml_path, rocklab::calibrate::to_toml(&cal)).unwrap();
     let (ei, eo) = rocklab::facade::read_calibration(&toml_path).unwrap();
     assert_eq!((ei, eo), (cal.e_in, cal.e_out));
+    // Issue 10: it carries what a façade ensemble draws from, and the study's
+    // calibration set draws e_in ~ N(mean, √(sd_tests² + se_fit²)).
+    let file = rocklab::facade::read_calibration_file(&toml_path).unwrap();
+    let sp = file.spread.expect("[calibration.spread]");
+    let inc: Vec<_> = cal.tests.iter().filter(|t| cal.included.contains(&t.id)).collect();
+    assert_eq!(sp.n_tests, inc.len());
+    let n = inc.len() as f64;
+    let mean = inc.iter().map(|t| t.e_in).sum::<f64>() / n;
+    let sd = (inc.iter().map(|t| (t.e_in - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    assert!((sp.sd_e_in_tests - sd).abs() < 1e-12, "{} vs {sd}", sp.sd_e_in_tests);
+    assert!((sp.se_e_in_mean - sd / n.sqrt()).abs() < 1e-12);
+    let set = rocklab::facade::calibration_set("campaign", "calibration.toml", &file, "tests").unwrap();
+    match set.dist {
+        rocklab::ensemble::CoefficientDist::Pair { e_in, .. } => assert_eq!(
+            e_in,
+            rocklab::ensemble::Dist::Normal {
+                mean: cal.e_in,
+                sd: sp.sd_e_in_tests.hypot(sp.se_e_in_fit)
+            }
+        ),
+        other => panic!("one-sided calibration gives a pair, not {other:?}"),
+    }
+    assert!(rocklab::facade::calibration_set("c", "f", &file, "sideways").is_err());
 }

@@ -246,6 +246,9 @@ fn format_invariance() {
 }
 
 /// Regression for issue #2: `demo` writes tables and plots for both campaigns.
+/// Issue 10: and the façade's P(overturn) table for Housner, the paper's pair and
+/// this campaign's calibration, with the fragility plot (small ensembles: debug
+/// build).
 #[test]
 fn demo_writes_tables_and_plots() {
     let dir = tempfile::tempdir().unwrap();
@@ -254,11 +257,34 @@ fn demo_writes_tables_and_plots() {
         .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"))
         .arg("--out")
         .arg(dir.path())
+        .args(["--samples", "3", "--ida-samples", "1", "--scales", "0.5:1.5:3"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("| 150_1 |"), "{stdout}");
+    assert!(stdout.contains("| P(overturn) |"), "{stdout}");
+    let f = dir.path().join("facade");
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(f.join("summary.json")).unwrap()).unwrap();
+    let rows = s["ensemble"]["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3 * 2 * 3, "records × polarities × sets");
+    for set in ["housner", "calibrated", "campaign"] {
+        assert!(rows.iter().any(|r| r["coefficients"] == set), "{set}");
+        assert!(stdout.contains(&format!("| {set} | **")), "{set} row in {stdout}");
+    }
+    for r in rows {
+        let p = r["p_overturn"].as_f64().unwrap();
+        let ci = r["p_overturn_ci95"].as_array().unwrap();
+        assert!(ci[0].as_f64().unwrap() <= p && p <= ci[1].as_f64().unwrap());
+    }
+    let fits = s["fragility"]["sets"].as_array().unwrap();
+    assert_eq!(fits.len(), 3);
+    for f in fits {
+        assert!(f["fit"].get("median").is_some() || f["fit"].get("error").is_some(), "{f}");
+    }
+    assert_eq!(&std::fs::read(f.join("fragility.png")).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
+    let html = std::fs::read_to_string(f.join("report.html")).unwrap();
+    assert!(html.contains("id=\"ensemble\"") && html.contains("id=\"fragility\"") && html.contains("P(overturn)"));
     for c in ["one-sided-demo", "two-sided-demo"] {
         let d = dir.path().join(c);
         for f in ["summary.json", "table1.csv", "table1.md", "table2.csv", "table3.md", "tables.md"] {
@@ -513,4 +539,57 @@ fn calibrate_then_simulate_with_the_calibration() {
     let r: Value = serde_json::from_str(&std::fs::read_to_string(sim.join("summary.json")).unwrap()).unwrap();
     assert_eq!(r["e_in"], c["e_in"]);
     assert_eq!(r["e_out"], c["e_out"]);
+}
+
+/// Issue 10: a study with an ensemble writes P(overturn) first, ensemble.csv and
+/// samples.csv, and the numbers are the same on one thread and on two (same seed).
+#[test]
+fn facade_ensemble_same_seed_same_numbers_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let body = SMALL_STUDY.replace(
+        "polarities = [1]",
+        "polarities = [1]\nsamples = 4\nseed = 5\n[uncertainty]\nmagnification = { uniform = [0.9, 1.1] }\nalpha_rad = { normal = [0.1, 0.002] }",
+    );
+    let study = write_study(dir.path(), &body);
+    let mut outs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("out{threads}"));
+        let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+            .arg("facade")
+            .arg(&study)
+            .arg("--out")
+            .arg(&out)
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+        assert!(md.starts_with("| record | polarity | coefficients | P(overturn) |"), "{md}");
+        outs.push((
+            std::fs::read(out.join("ensemble.csv")).unwrap(),
+            std::fs::read(out.join("samples.csv")).unwrap(),
+        ));
+    }
+    assert_eq!(outs[0], outs[1]);
+    let samples = String::from_utf8(outs[0].1.clone()).unwrap();
+    assert_eq!(samples.lines().count(), 1 + 4 * 2, "header + 4 samples × 2 sets");
+}
+
+/// Issue 10: errors in the ensemble parts of a study name the key.
+#[test]
+fn facade_ensemble_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    for (add, expect) in [
+        ("[uncertainty]\nmagnificaton = 1.0", "magnificaton"),
+        ("[uncertainty]\nmagnification = { normal = [1.0] }", "normal = [mean, sd]"),
+        ("[uncertainty]\nalpha_rad = { triangle = [0.1, 0.2] }", "alpha_rad"),
+    ] {
+        let study = write_study(dir.path(), &SMALL_STUDY.replace("[[record]]", &format!("{add}\n\n[[record]]")));
+        let o = facade(&study, &dir.path().join("o"), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
+    }
+    let study = write_study(dir.path(), &SMALL_STUDY.replace("e_out = 0.68", "e_out = 0.68\nsd_e = -0.1"));
+    let o = facade(&study, &dir.path().join("o"), &[]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("sd_e = -0.1"));
 }

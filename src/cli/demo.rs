@@ -20,12 +20,27 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         ok &= cal.failed.is_empty();
         say("");
     }
-    let study = rocklab::facade::Study::load(&args.fixtures.join("facade/study.toml"))?;
-    say(&format!("façade study: {}", study.name));
+    let mut study = rocklab::facade::Study::load(&args.fixtures.join("facade/study.toml"))?;
+    args.ensemble.apply(&mut study);
+    // reduce → calibrate → façade: this campaign's calibration joins the study as
+    // a coefficient set, read back from the calibration.toml just written.
+    let cal_path = args.out.join("one-sided-demo").join("calibration.toml");
+    let cal = rocklab::facade::read_calibration_file(&cal_path)?;
+    let set = rocklab::facade::calibration_set("campaign", &cal_path.display().to_string(), &cal, "tests").map_err(|e| anyhow::anyhow!(e))?;
+    study.sets.push(set);
+    let scales = rocklab::facade::parse_scales(&args.scales)?;
+    say(&format!(
+        "façade study: {} ({} samples per record × polarity × set, seed {}; fragility from {} scales × {} samples)",
+        study.name,
+        study.samples,
+        study.seed,
+        scales.len(),
+        study.ida_samples
+    ));
     let out = args.out.join("facade");
     std::fs::create_dir_all(&out)?;
-    let (figs, md) = super::facade::study_outputs(&study, &out)?;
-    super::facade::write_report(&study, &md, &figs, &[], &out)?;
+    let rep = super::facade::run_all(&study, Some(&scales), &out)?;
+    super::facade::write_report(&study, &rep, &out)?;
     say(&format!("wrote {}", out.display()));
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

@@ -80,6 +80,11 @@ pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "reports/demo")]
     pub out: PathBuf,
+    /// Scale factors of the façade's fragility IDA, FROM:TO:N (× the magnification).
+    #[arg(long, default_value = "0.2:2.0:10")]
+    pub scales: String,
+    #[command(flatten)]
+    pub ensemble: facade::EnsembleArgs,
 }
 
 pub fn run() -> anyhow::Result<ExitCode> {

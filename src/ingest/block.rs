@@ -91,6 +91,9 @@ pub struct BlockSpec {
     pub restraint: Restraint,
     pub ties: Vec<TieRod>,
     pub impact: ImpactDefaults,
+    /// (K'_c in MN/m², contact height in m) when the restraint is given as a
+    /// spring bed (the façade ensembles vary them).
+    pub spring_bed: Option<(f64, f64)>,
     /// Which of R, α, I_0, mass were overridden.
     pub overrides: Vec<String>,
 }
@@ -142,6 +145,11 @@ impl BlockSpec {
             }
             None => 4.0 / 3.0 * block.mass_kg * block.r_m * block.r_m,
         };
+        let spring_bed = raw
+            .restraint
+            .as_ref()
+            .and_then(|r| r.unit_stiffness_mn_m2.zip(r.contact_height_m))
+            .filter(|_| raw.restraint.as_ref().is_some_and(|r| r.rotational_stiffness_mnm_rad.is_none()));
         let restraint = match &raw.restraint {
             None => Restraint::None,
             Some(r) => match (r.unit_stiffness_mn_m2, r.contact_height_m, r.rotational_stiffness_mnm_rad) {
@@ -180,6 +188,7 @@ impl BlockSpec {
             restraint,
             ties,
             impact: raw.impact.unwrap_or_default(),
+            spring_bed,
             overrides,
         })
     }

@@ -18,6 +18,9 @@ pub struct Settings {
     pub max_step: f64,
     /// Keep the time history (off for batch runs).
     pub keep_history: bool,
+    /// Stop at rest once no later sample can uplift the wall (|ü_g| ≤ g tan α
+    /// from there on): it stays at rest, so the run's result is already known.
+    pub stop_at_rest: bool,
 }
 
 impl Settings {
@@ -28,6 +31,7 @@ impl Settings {
             rest_speed: 1e-7,
             max_step: 0.01,
             keep_history: true,
+            stop_at_rest: true,
         }
     }
     pub fn with_tolerances(mut self, rtol: f64, atol: f64) -> Settings {
@@ -37,6 +41,12 @@ impl Settings {
     }
     pub fn without_history(mut self) -> Settings {
         self.keep_history = false;
+        self
+    }
+    /// Scan the record for the next uplift even after the last sample that could
+    /// cause one (for the test that the early stop changes nothing).
+    pub fn without_stop_at_rest(mut self) -> Settings {
+        self.stop_at_rest = false;
         self
     }
 }
@@ -166,6 +176,8 @@ fn simulate_inner(model: &RockingModel, ground: &Ground, t0: f64, initial: Optio
         _ => Phase::Rest,
     };
     let thr = model.uplift_threshold();
+    // After `quiet`, |ü_g| ≤ threshold everywhere (found on the first rest).
+    let mut quiet: Option<f64> = None;
     let mut h = 1e-3f64.min(settings.max_step);
     let push = |sim: &mut Simulation, t: f64, y: &State| {
         sim.max_theta = sim.max_theta.max(y[0]);
@@ -184,7 +196,12 @@ fn simulate_inner(model: &RockingModel, ground: &Ground, t0: f64, initial: Optio
         match phase {
             Phase::Rest => {
                 y = [0.0, 0.0];
-                let next = next_uplift(ground, t, settings.t_end, thr);
+                let q = *quiet.get_or_insert_with(|| quiet_after(ground, thr));
+                let next = if settings.stop_at_rest && t >= q {
+                    None
+                } else {
+                    next_uplift(ground, t, settings.t_end, thr)
+                };
                 out.fill(next.map_or(settings.t_end, |n| n.0), |_| 0.0);
                 match next {
                     Some((tu, side)) => {
@@ -361,6 +378,16 @@ fn next_sample_after(g: &Ground, t: f64) -> f64 {
     }
     let k = ((t - g.t0) / g.dt * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
     g.t0 + g.dt * k
+}
+
+/// The time after which |ü_g| ≤ threshold for good: the end of the interval after
+/// the last sample above it (ü_g is linear between samples, so it can only exceed
+/// the threshold next to such a sample); the record's start if none is.
+fn quiet_after(g: &Ground, thr: f64) -> f64 {
+    match g.acc.iter().rposition(|a| a.abs() > thr) {
+        Some(i) => g.time((i + 1).min(g.acc.len().saturating_sub(1))),
+        None => g.t0,
+    }
 }
 
 /// Next time ≥ t when |ü_g| exceeds the threshold (exact on the piecewise-linear

@@ -4,7 +4,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use serde_json::json;
 
 use super::say;
 use super::simulate::response_panels;
@@ -124,18 +123,7 @@ pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Figures, Stri
     let runs = run_study(study, 1.0, true, &|| pb.inc(1));
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
-    let doc = json!({
-        "study": study.name,
-        "block": study.block.name,
-        "alpha_rad": study.block.block.alpha,
-        "magnification": study.magnification,
-        "overturn_limit_rad": study.overturn_limit,
-        "rtol": study.rtol,
-        "e_housner_eq2": study.e_housner_eq2,
-        "coefficient_sets": study.sets,
-        "wall_s": wall,
-        "runs": runs,
-    });
+    let doc = rocklab::report::docs::facade_summary(study, &runs, wall);
     write_atomic(&out.join("summary.json"), &serde_json::to_vec_pretty(&doc)?)?;
     let (csv, md) = results_table(study, &runs)?;
     write_atomic(&out.join("results.csv"), &csv)?;

@@ -29,6 +29,7 @@ import csv
 import io
 import json
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
@@ -55,6 +56,7 @@ __all__ = [
     "plan_facade",
     "study_info",
     "parse_scales",
+    "read_csv",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -72,20 +74,25 @@ def _frame(rows: list, columns: Optional[Sequence[str]] = None):
     return _pd.DataFrame(rows, columns=columns)
 
 
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|NaN|nan)")
+
+
+def read_csv(source, **kwargs):
+    """``pandas.read_csv`` with exact (round-trip) float parsing on every pandas
+    version (pandas < 3 needs ``float_precision="round_trip"`` for it)."""
+    if int(_pd.__version__.split(".")[0]) < 3:
+        kwargs.setdefault("float_precision", "round_trip")
+    return _pd.read_csv(source, **kwargs)
+
+
 def _read_csv(text: str):
     """A CSV table written by the CLI: a DataFrame (exact float parsing), or a list
     of dicts with floats where a cell is a number."""
     if _pd is not None:
-        return _pd.read_csv(io.StringIO(text), float_precision="round_trip")
+        return read_csv(io.StringIO(text))
     rows = []
     for r in csv.DictReader(io.StringIO(text)):
-        row = {}
-        for k, v in r.items():
-            try:
-                row[k] = float(v) if v != "" else None
-            except ValueError:
-                row[k] = v
-        rows.append(row)
+        rows.append({k: (float(v) if _NUMBER.fullmatch(v) else (None if v == "" else v)) for k, v in r.items()})
     return rows
 
 

@@ -97,6 +97,16 @@ def _simulate_partition(calls: list) -> list:
     return out
 
 
+def _absolute_paths(call: Mapping[str, Any]) -> dict:
+    """A call with its file arguments made absolute (workers may start elsewhere)."""
+    out = dict(call)
+    for key in ("block", "record", "calibration"):
+        v = out.get(key)
+        if isinstance(v, (str, os.PathLike)):
+            out[key] = os.path.abspath(os.fspath(v))
+    return out
+
+
 def simulate_many(client, calls: Sequence[Mapping[str, Any]], *, partitions: Optional[int] = None):
     """Run a list of :func:`rocklab.simulate` calls on a Dask cluster.
 
@@ -104,8 +114,9 @@ def simulate_many(client, calls: Sequence[Mapping[str, Any]], *, partitions: Opt
     ``record``, ``scale``, ``polarity``, ``e_in``, ...; paths must be readable by
     the workers). Returns one row per call, in order, with the scalar fields of
     each run's ``summary`` (the CLI's ``summary.json`` without events and notes).
+    Relative paths are made absolute here.
     """
-    calls = [dict(c) for c in calls]
+    calls = [_absolute_paths(c) for c in calls]
     parts = partition(calls, partitions or _default_partitions(client, len(calls)))
     futures = client.map(_simulate_partition, parts, pure=False)
     rows = [row for part in client.gather(futures) for row in part]

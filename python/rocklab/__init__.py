@@ -144,7 +144,8 @@ class ReduceResult:
         summary: the CLI's ``summary.json`` as a dict (SPEC's output contract).
         tests: one row per test: id, status, every coefficient and ratio (and any
             field the summary gains, e.g. uncertainties), error where it failed.
-        peaks: one row per velocity peak: test, k, time_s, velocity_mm_s.
+        peaks: one row per velocity peak: test, k, time_s, velocity_mm_s (and any
+            field a peak gains in the summary).
         tables: ``table1``..``table3`` as the CLI writes them (``tableN.csv``).
         captions: the caption of each table.
         series: per test id, NumPy arrays ``t_s``, ``displacement_mm`` (zero at the
@@ -171,6 +172,11 @@ class ReduceResult:
         return self.summary.get("mean_left_out", [])
 
     @property
+    def statuses(self) -> dict:
+        """{test id: status} ("ok", "error", or any status the summary gains)."""
+        return {t["id"]: t.get("status") for t in self.summary["tests"]}
+
+    @property
     def failed(self) -> dict:
         """{test id: error message} of the tests that could not be reduced."""
         return {t["id"]: t["error"] for t in self.summary["tests"] if t.get("status") == "error"}
@@ -189,14 +195,9 @@ class ReduceResult:
 def _reduce_result(doc: dict, raw: Mapping[str, bytes]) -> ReduceResult:
     summary = doc["summary"]
     tests = _frame(_scalar_columns(summary["tests"]))
-    peaks = _frame(
-        [
-            {"test": t["id"], "k": k, "time_s": p["time_s"], "velocity_mm_s": p["velocity_mm_s"]}
-            for t in summary["tests"]
-            for k, p in enumerate(t.get("peaks", []))
-        ],
-        columns=["test", "k", "time_s", "velocity_mm_s"],
-    )
+    peak_rows = [{"test": t["id"], "k": k, **p} for t in summary["tests"] for k, p in enumerate(t.get("peaks", []))]
+    # Every field a peak carries (time_s, velocity_mm_s, and any the summary gains).
+    peaks = _frame(peak_rows, columns=None if peak_rows else ["test", "k", "time_s", "velocity_mm_s"])
     tables = {t["name"]: _read_csv(t["csv"]) for t in doc["tables"]}
     captions = {t["name"]: t["caption"] for t in doc["tables"]}
     series: dict = {}

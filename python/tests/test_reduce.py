@@ -31,6 +31,9 @@ def test_reduce_equals_cli_summary_and_tables(cli, tmp_path, manifest):
     assert len(res.peaks) == sum(len(t["peaks"]) for t in ok)
     assert res.mean == expected["mean"]
     assert res.left_out == expected["mean_left_out"]
+    assert res.statuses == {t["id"]: t["status"] for t in expected["tests"]}
+    first = res.peaks[res.peaks["test"] == ok[0]["id"]]
+    assert list(first["velocity_mm_s"]) == [p["velocity_mm_s"] for p in ok[0]["peaks"]]
 
 
 def test_reduce_savgol_equals_cli(cli, tmp_path):

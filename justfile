@@ -26,3 +26,17 @@ bench:
 bench-mem: bench
     cargo build --release
     /usr/bin/time -v target/release/rocklab reduce target/bench-data/campaign.toml --out target/bench-data/out --no-plots 2>&1 | grep -E "Maximum resident|Elapsed"
+
+# The Python package (python/): release build and install, as the README says.
+python-install:
+    pip install ./python
+
+# Debug build of the extension, installed, then the pytest suite (what CI runs).
+python-test:
+    cd python && python3 -m maturin build --profile dev --out ../target/wheels
+    pip install --force-reinstall --no-deps target/wheels/rocklab-*.whl
+    python3 -m pytest python/tests -q
+
+# The example notebook: figures into python/examples/out/.
+python-example:
+    python3 python/examples/notebook.py

@@ -76,18 +76,22 @@ pub fn read_log(spec: &TestSpec) -> Result<LogData, String> {
         .map_err(|e| e.to_string())
 }
 
-/// Reduce one test.
+/// Reduce one test: [`read_log`], then [`reduce_loaded`].
 pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) -> TestOutcome {
-    let log = match read_log(spec) {
-        Ok(l) => l,
-        Err(e) => {
-            return TestOutcome {
-                spec: spec.clone(),
-                result: Err(e),
-                warnings: Vec::new(),
-            }
-        }
-    };
+    match read_log(spec) {
+        Ok(log) => reduce_loaded(campaign, spec, log, options),
+        Err(e) => TestOutcome {
+            spec: spec.clone(),
+            result: Err(e),
+            warnings: Vec::new(),
+        },
+    }
+}
+
+/// Reduce one test whose log is already in memory (read by another reader, e.g.
+/// the Python binding's arrays): `log` must hold time in s and displacement in mm,
+/// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
+pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
     let warnings = log.warnings.clone();
     let file = spec.file.display().to_string();
     let result = analyse(&log.time_s, &log.disp_mm, &physics(campaign, spec), options)
@@ -129,6 +133,12 @@ pub fn reduce_campaign_with(campaign: Campaign, options: PeakOptions, tick: &(dy
             o
         })
         .collect();
+    campaign_result(campaign, options, tests)
+}
+
+/// A campaign result from its reduced tests (one outcome per test of `campaign`,
+/// in order): the means over them, as [`reduce_campaign`] computes them.
+pub fn campaign_result(campaign: Campaign, options: PeakOptions, tests: Vec<TestOutcome>) -> CampaignResult {
     let rows: Vec<Row> = tests
         .iter()
         .map(|t| Row {

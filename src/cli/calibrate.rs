@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use serde_json::json;
 
 use super::say;
 use rocklab::atomic::write_atomic;
@@ -40,21 +39,7 @@ pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow
     let wall = start.elapsed().as_secs_f64();
     std::fs::create_dir_all(out)?;
     write_atomic(&out.join("calibration.toml"), to_toml(&cal).as_bytes())?;
-    let calibration = json!({
-        "e_in": cal.e_in, "e_out": cal.e_out, "r_in": cal.r_in, "r_out": cal.r_out,
-        "e_housner": cal.e_housner,
-        "included": cal.included,
-        "joint": cal.joint,
-        "tests": cal.tests.iter().map(|t| json!({
-            "id": t.id, "e_in": t.e_in, "e_out": t.e_out, "rms_mm": t.rms_mm,
-            "se_e_in": t.se_e_in, "se_e_out": t.se_e_out, "ci95_e_in": t.ci95_e_in, "ci95_e_out": t.ci95_e_out,
-            "release_offset_s": t.release_offset_s, "zero_offset_mm": t.zero_offset_mm, "p2_factor": t.p2_factor,
-            "kappa_per_s2": t.kappa_per_s2, "nrmse": t.nrmse, "iterations": t.iterations, "stop": t.stop,
-        })).collect::<Vec<_>>(),
-        "per_impact": cal.per_impact.iter().map(|(id, i, o)| json!({"id": id, "inward": i, "outward": o})).collect::<Vec<_>>(),
-        "failed": cal.failed.iter().map(|(id, e)| json!({"id": id, "error": e})).collect::<Vec<_>>(),
-        "wall_s": wall,
-    });
+    let calibration = rocklab::report::docs::calibration_summary(&cal, wall);
     // Everything reduce writes, with the calibration in summary.json and report.html.
     let figs = plots_for(res, &cal, out, n)?;
     let extra = Extras {

@@ -1,10 +1,10 @@
 //! `rocklab facade STUDY --out DIR [--scales FROM:TO:N]`.
 
+use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use serde_json::json;
 
 use super::say;
 use super::simulate::response_panels;
@@ -88,17 +88,9 @@ pub fn run_all(study: &Study, scales: Option<&[f64]>, out: &Path) -> anyhow::Res
     let start = std::time::Instant::now();
     let (runs, figs, md) = study_outputs(study, out)?;
     rep.figs = figs;
-    let mut doc = json!({
-        "study": study.name,
-        "block": study.block.name,
-        "alpha_rad": study.block.block.alpha,
-        "magnification": study.magnification,
-        "overturn_limit_rad": study.overturn_limit,
-        "rtol": study.rtol,
-        "e_housner_eq2": study.e_housner_eq2,
-        "coefficient_sets": study.sets,
-        "runs": runs,
-    });
+    // The nominal study's document (shared with the Python binding), then the
+    // ensemble and fragility sections; wall_s is the whole study's.
+    let mut doc = rocklab::report::docs::facade_summary(study, &runs, 0.0);
     let mut ens_samples = Vec::new();
     if study.samples > 0 {
         let (table, rows, samples) = ensemble_outputs(study, &runs, out)?;

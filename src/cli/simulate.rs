@@ -5,7 +5,6 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
-use serde_json::json;
 
 use super::say;
 use rocklab::atomic::write_atomic;
@@ -140,24 +139,7 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     let (summary, sim) = run(&block, &record, &spec);
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let alpha = block.block.alpha;
-    let doc = json!({
-        "block": block.name,
-        "record": a.record.display().to_string(),
-        "record_notes": record.notes,
-        "alpha_rad": alpha, "p2_per_s2": block.block.p2(), "i0_kg_m2": block.block.i0, "mass_kg": block.block.mass_kg, "r_m": block.block.r_m,
-        "e_in": e_in, "e_out": e_out, "scale": a.scale, "polarity": a.polarity, "overturn_limit_rad": limit,
-        "rtol": a.rtol, "atol": a.atol,
-        "max_theta_over_alpha": summary.max_theta_over_alpha,
-        "min_theta_over_alpha": summary.min_theta_over_alpha,
-        "overturned": summary.overturned,
-        "overturn_time_s": summary.overturn_time_s,
-        "impacts": summary.impacts,
-        "pga_g": summary.pga_g,
-        "pgv_cm_s": summary.pgv_cm_s,
-        "solve_wall_s": summary.solve_wall_s,
-        "steps": summary.steps,
-        "events": sim.events,
-    });
+    let doc = rocklab::report::docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim);
     write_atomic(&a.out.join("summary.json"), &serde_json::to_vec_pretty(&doc)?)?;
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(["t_s", "theta_rad", "theta_over_alpha", "theta_dot_rad_s", "ag_m_s2"])?;

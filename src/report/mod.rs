@@ -1,6 +1,7 @@
 //! The output edge: the `summary.json` contract, the tables as CSV and Markdown,
 //! and the plots. Renderers return bytes; [`crate::atomic::write_atomic`] writes.
 
+pub mod docs;
 pub mod html;
 pub mod plots;
 pub mod summary;

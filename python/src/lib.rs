@@ -1,0 +1,478 @@
+//! `rocklab._rocklab`: the Python extension of rocklab (PyO3).
+//!
+//! A thin layer over the library: every function calls the same library code as
+//! the CLI and returns the CLI's JSON document as text (the Python package parses
+//! it into dicts and DataFrames) and time series as little-endian f64 bytes (the
+//! package wraps them in NumPy arrays without a copy). Errors are raised as
+//! `rocklab.RocklabError` (a `ValueError`) with the message the CLI prints; a Rust
+//! panic is caught and raised the same way, never crashing the interpreter. Every
+//! computation runs with the GIL released.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use rayon::prelude::*;
+use serde_json::{json, Value};
+
+use rocklab::facade::{run_ida, run_study, Study};
+use rocklab::ground_motion::{self, Format, ReadOptions, Record, Units};
+use rocklab::ingest::block::BlockSpec;
+use rocklab::ingest::{Campaign, LogData};
+use rocklab::peaks::{Method, PeakOptions};
+use rocklab::reduce::{campaign_result, reduce_campaign, reduce_loaded, CampaignResult};
+use rocklab::report::{docs, summary::summary, tables};
+use rocklab::signal::savgol::SavGol;
+use rocklab::study::{run, RunSpec};
+
+pyo3::create_exception!(
+    _rocklab,
+    RocklabError,
+    pyo3::exceptions::PyValueError,
+    "Bad input or a failed computation; the message is the one the rocklab CLI prints (file, line, column where it applies)."
+);
+
+/// Named f64 series returned to Python as bytes.
+type Series = Vec<(String, Vec<f64>)>;
+
+/// Run `f` with the GIL released; an error becomes `RocklabError` with the CLI's
+/// message (`{e:#}`: the context chain), a panic becomes `RocklabError` too.
+fn guarded<T: Send>(py: Python<'_>, f: impl FnOnce() -> anyhow::Result<T> + Send) -> PyResult<T> {
+    match py.detach(move || catch_unwind(AssertUnwindSafe(f))) {
+        Ok(Ok(v)) => Ok(v),
+        Ok(Err(e)) => Err(RocklabError::new_err(format!("{e:#}"))),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(RocklabError::new_err(format!("internal error in rocklab (please report it): {what}")))
+        }
+    }
+}
+
+/// (JSON text, {name: f64 little-endian bytes}) for Python.
+fn to_python<'py>(py: Python<'py>, doc: Value, series: Series) -> PyResult<(String, Bound<'py, PyDict>)> {
+    let d = PyDict::new(py);
+    for (name, v) in series {
+        let bytes: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
+        d.set_item(name, PyBytes::new(py, &bytes))?;
+    }
+    Ok((doc.to_string(), d))
+}
+
+/// f64 values from little-endian bytes (the package sends `ndarray.tobytes()`).
+fn f64s(name: &str, b: &[u8]) -> anyhow::Result<Vec<f64>> {
+    if b.len() % 8 != 0 {
+        bail!("{name}: {} bytes is not a whole number of float64 values", b.len());
+    }
+    Ok(b.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
+}
+
+/// Every value finite, or the first that is not, by name and index.
+fn finite(name: &str, v: &[f64]) -> anyhow::Result<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => bail!("{name}[{i}] = {}: expected finite numbers", v[i]),
+        None => Ok(()),
+    }
+}
+
+/// The estimator settings, as `rocklab reduce --method --window --order`.
+fn peak_options(method: &str, window: usize, order: usize) -> anyhow::Result<PeakOptions> {
+    let method = match method {
+        "segments" => Method::Segments,
+        "savgol" => Method::SavGol(SavGol::new(window, order).map_err(anyhow::Error::msg)?),
+        other => bail!("method = {other:?}: expected \"segments\" or \"savgol\""),
+    };
+    Ok(PeakOptions { n_peaks: 6, method })
+}
+
+/// The reduce result for Python: `summary` (exactly the CLI's summary.json),
+/// `tables` (name, caption, the CLI's CSV text), and per-test series.
+fn reduce_doc(res: &CampaignResult, with_series: bool) -> anyhow::Result<(Value, Series)> {
+    let tabs = tables::tables(res)
+        .iter()
+        .map(|t| {
+            let csv = String::from_utf8(tables::to_csv(t)?)?;
+            Ok(json!({"name": t.name, "caption": t.caption, "csv": csv}))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut series = Series::new();
+    if with_series {
+        for t in &res.tests {
+            if let Ok(r) = &t.result {
+                let a = &r.analysis;
+                let id = &t.spec.id;
+                series.push((format!("{id}/t_s"), r.log.time_s.clone()));
+                series.push((format!("{id}/displacement_mm"), a.displacement_mm.clone()));
+                series.push((format!("{id}/velocity_mm_s"), a.velocity_mm_s.clone()));
+                series.push((format!("{id}/fit_t_s"), a.fit_curve.iter().map(|p| p.0).collect()));
+                series.push((format!("{id}/fit_displacement_mm"), a.fit_curve.iter().map(|p| p.1).collect()));
+                series.push((format!("{id}/fit_velocity_mm_s"), a.fit_curve.iter().map(|p| p.2).collect()));
+            }
+        }
+    }
+    Ok((json!({"summary": summary(res), "tables": tabs}), series))
+}
+
+/// `rocklab reduce MANIFEST` without writing files.
+#[pyfunction]
+#[pyo3(signature = (manifest, method="segments", window=11, order=3, series=false))]
+fn reduce<'py>(
+    py: Python<'py>,
+    manifest: PathBuf,
+    method: &str,
+    window: usize,
+    order: usize,
+    series: bool,
+) -> PyResult<(String, Bound<'py, PyDict>)> {
+    let method = method.to_string();
+    let (doc, s) = guarded(py, move || {
+        let opts = peak_options(&method, window, order)?;
+        let campaign = Campaign::load(&manifest)?;
+        reduce_doc(&reduce_campaign(campaign, opts), series)
+    })?;
+    to_python(py, doc, s)
+}
+
+/// One test given as arrays: `manifest_json` is a campaign manifest (SPEC) as JSON
+/// with one `[[test]]`; `t` and `x` are the log's time and displacement columns in
+/// the units of its channels.
+#[pyfunction]
+#[pyo3(signature = (manifest_json, t, x, method="segments", window=11, order=3))]
+fn reduce_log<'py>(
+    py: Python<'py>,
+    manifest_json: &str,
+    t: &[u8],
+    x: &[u8],
+    method: &str,
+    window: usize,
+    order: usize,
+) -> PyResult<(String, Bound<'py, PyDict>)> {
+    let (manifest_json, t, x, method) = (manifest_json.to_string(), t.to_vec(), x.to_vec(), method.to_string());
+    let (doc, s) = guarded(py, move || {
+        let opts = peak_options(&method, window, order)?;
+        let value: Value = serde_json::from_str(&manifest_json)?;
+        let text = toml::to_string(&value).context("the manifest as TOML")?;
+        let campaign = Campaign::parse(&text, Path::new("<reduce_log>"))?;
+        let spec = campaign.tests.first().ok_or_else(|| anyhow!("no test"))?.clone();
+        let (t, x) = (f64s("t", &t)?, f64s("x", &x)?);
+        if t.len() != x.len() {
+            bail!("t has {} values and x {}: expected one displacement per time", t.len(), x.len());
+        }
+        finite("t", &t)?;
+        finite("x", &x)?;
+        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+            bail!("t[{}] = {} after t[{i}] = {}: expected strictly increasing time", i + 1, t[i + 1], t[i]);
+        }
+        let (to_s, to_mm) = (spec.time.unit.to_s(), spec.displacement.unit.to_mm() * spec.outward_sign);
+        let log = LogData {
+            time_s: t.iter().map(|v| v * to_s).collect(),
+            disp_mm: x.iter().map(|v| v * to_mm).collect(),
+            notes: vec!["arrays passed from Python".into()],
+            warnings: Vec::new(),
+        };
+        let outcome = reduce_loaded(&campaign, &spec, log, &opts);
+        reduce_doc(&campaign_result(campaign, opts, vec![outcome]), true)
+    })?;
+    to_python(py, doc, s)
+}
+
+/// A block: a BLOCK.toml path, or the same tables as JSON (validated alike).
+fn load_block(path: Option<PathBuf>, json_text: Option<String>) -> anyhow::Result<BlockSpec> {
+    match (path, json_text) {
+        (Some(p), None) => BlockSpec::load(&p),
+        (None, Some(j)) => {
+            let v: Value = serde_json::from_str(&j)?;
+            BlockSpec::parse(&toml::to_string(&v).context("the block as TOML")?, Path::new("<block>"))
+        }
+        _ => bail!("give the block as a path or as a dict"),
+    }
+}
+
+/// A record: a file (any format the CLI reads), or an acceleration array with dt
+/// and units.
+fn load_record(
+    path: Option<PathBuf>,
+    acc: Option<Vec<u8>>,
+    format: Option<String>,
+    dt: Option<f64>,
+    units: Option<String>,
+) -> anyhow::Result<(String, Record)> {
+    let units = units
+        .as_deref()
+        .map(|u| Units::parse(u).ok_or_else(|| anyhow!("units = {u:?}: expected g, m/s2 or cm/s2")))
+        .transpose()?;
+    match (path, acc) {
+        (Some(p), None) => {
+            let format = match format.as_deref() {
+                None | Some("auto") => None,
+                Some("esm") => Some(Format::Esm),
+                Some("at2") => Some(Format::At2),
+                Some("cosmos") => Some(Format::Cosmos),
+                Some("two-column") => Some(Format::TwoColumn),
+                Some("one-column") => Some(Format::OneColumn),
+                Some(o) => bail!("format = {o:?}: expected auto, esm, at2, cosmos, two-column or one-column"),
+            };
+            let rec = ground_motion::read(&p, &ReadOptions { format, dt, units })?;
+            Ok((p.display().to_string(), rec))
+        }
+        (None, Some(bytes)) => {
+            let acc = f64s("acceleration", &bytes)?;
+            finite("acceleration", &acc)?;
+            if acc.len() < 2 {
+                bail!("the acceleration array has {} values: expected at least 2", acc.len());
+            }
+            let dt = dt.ok_or_else(|| anyhow!("dt is missing: an acceleration array needs its time step (s)"))?;
+            if !(dt.is_finite() && dt > 0.0) {
+                bail!("dt = {dt}: expected a positive time step (s)");
+            }
+            let units = units.ok_or_else(|| anyhow!("units is missing: an acceleration array needs units g, m/s2 or cm/s2"))?;
+            let k = units.to_m_s2();
+            let rec = Record {
+                path: PathBuf::from("<array>"),
+                format: Format::OneColumn,
+                units,
+                t0: 0.0,
+                dt,
+                acc_m_s2: acc.iter().map(|a| a * k).collect(),
+                notes: Vec::new(),
+            };
+            Ok(("<array>".into(), rec))
+        }
+        _ => bail!("give the record as a path or as an acceleration array"),
+    }
+}
+
+fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
+    if e > 0.0 && e <= 1.0 {
+        Ok(e)
+    } else {
+        bail!("{name} = {e}: expected 0 < e ≤ 1")
+    }
+}
+
+/// `rocklab simulate` without writing files: (summary.json, history).
+#[pyfunction]
+#[pyo3(signature = (block_path=None, block_json=None, record_path=None, acc=None, format=None, dt=None, units=None,
+                    scale=1.0, polarity=1, e=None, e_in=None, e_out=None, calibration=None, overturn_limit=None,
+                    t_extra=0.0, rtol=1e-8, atol=1e-10, history=true))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    block_path: Option<PathBuf>,
+    block_json: Option<String>,
+    record_path: Option<PathBuf>,
+    acc: Option<&[u8]>,
+    format: Option<String>,
+    dt: Option<f64>,
+    units: Option<String>,
+    scale: f64,
+    polarity: i32,
+    e: Option<f64>,
+    e_in: Option<f64>,
+    e_out: Option<f64>,
+    calibration: Option<PathBuf>,
+    overturn_limit: Option<f64>,
+    t_extra: f64,
+    rtol: f64,
+    atol: f64,
+    history: bool,
+) -> PyResult<(String, Bound<'py, PyDict>)> {
+    let acc = acc.map(|a| a.to_vec());
+    let (doc, s) = guarded(py, move || {
+        let block = load_block(block_path, block_json)?;
+        let (record_name, record) = load_record(record_path, acc, format, dt, units)?;
+        let d = block.impact;
+        let (e_in, e_out) = match (calibration, e, e_in, e_out) {
+            (Some(file), None, None, None) => rocklab::facade::read_calibration(&file)?,
+            (Some(_), ..) => bail!("give calibration, or e, or e_in with e_out: not several"),
+            (None, Some(e), None, None) => (e, e),
+            (None, None, Some(i), Some(o)) => (i, o),
+            (None, None, None, None) => match (d.e, d.e_in, d.e_out) {
+                (Some(e), _, _) => (e, e),
+                (None, Some(i), Some(o)) => (i, o),
+                _ => bail!("no coefficient of restitution: pass e=E, e_in=X with e_out=Y or calibration=FILE (or set [impact] in the block)"),
+            },
+            _ => bail!("pass e=E, or both e_in and e_out"),
+        };
+        let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
+        if polarity != 1 && polarity != -1 {
+            bail!("polarity = {polarity}: expected 1 or -1");
+        }
+        if !(scale.is_finite() && scale > 0.0) {
+            bail!("scale = {scale}: expected a positive number");
+        }
+        let spec = RunSpec {
+            e_in,
+            e_out,
+            scale,
+            polarity: polarity as f64,
+            overturn_limit: overturn_limit.or(d.overturn_limit_rad).unwrap_or(block.block.alpha),
+            t_extra,
+            rtol,
+            atol,
+            keep_history: history,
+        };
+        let (summary, sim) = run(&block, &record, &spec);
+        let doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim);
+        let alpha = block.block.alpha;
+        let h = &sim.history;
+        let series: Series = vec![
+            ("t_s".into(), h.iter().map(|s| s.t).collect()),
+            ("theta_rad".into(), h.iter().map(|s| s.theta).collect()),
+            ("theta_over_alpha".into(), h.iter().map(|s| s.theta / alpha).collect()),
+            ("theta_dot_rad_s".into(), h.iter().map(|s| s.omega).collect()),
+            ("ag_m_s2".into(), h.iter().map(|s| s.ag).collect()),
+        ];
+        Ok((doc, series))
+    })?;
+    to_python(py, doc, s)
+}
+
+/// `rocklab calibrate MANIFEST` without writing files: the summary.json it writes
+/// (the reduce summary with `"calibration"`), the tables and calibration.toml.
+#[pyfunction]
+#[pyo3(signature = (manifest, impacts=6))]
+fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<String> {
+    let doc = guarded(py, move || {
+        let campaign = Campaign::load(&manifest)?;
+        let res = reduce_campaign(campaign, PeakOptions::default());
+        let start = Instant::now();
+        let cal = rocklab::calibrate::calibrate(&res, impacts);
+        let wall = start.elapsed().as_secs_f64();
+        let (mut doc, _) = reduce_doc(&res, false)?;
+        doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall);
+        doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal));
+        Ok(doc)
+    })?;
+    Ok(doc.to_string())
+}
+
+/// `rocklab facade STUDY [--scales]` without writing files: the summary.json it
+/// writes, and the IDA points (ida.csv) when scales are given.
+#[pyfunction]
+#[pyo3(signature = (study, scales=None))]
+fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<String> {
+    let doc = guarded(py, move || {
+        let study = Study::load(&study)?;
+        let start = Instant::now();
+        let runs = run_study(&study, 1.0, false, &|| {});
+        let wall = start.elapsed().as_secs_f64();
+        let ida = scales.map(|sc| run_ida(&study, &sc, &|| {}));
+        Ok(json!({"summary": docs::facade_summary(&study, &runs, wall), "ida": ida}))
+    })?;
+    Ok(doc.to_string())
+}
+
+/// Scale factors of `--scales FROM:TO:N`.
+#[pyfunction]
+fn parse_scales(py: Python<'_>, text: &str) -> PyResult<Vec<f64>> {
+    let text = text.to_string();
+    guarded(py, move || rocklab::facade::parse_scales(&text))
+}
+
+/// The records, coefficient sets and polarities of a study (in the order of its
+/// combinations), to plan runs.
+#[pyfunction]
+fn study_info(py: Python<'_>, study: PathBuf) -> PyResult<String> {
+    let doc = guarded(py, move || {
+        let s = Study::load(&study)?;
+        Ok(json!({
+            "study": s.name,
+            "records": s.records.iter().map(|r| r.name.clone()).collect::<Vec<_>>(),
+            "coefficient_sets": s.sets,
+            "polarities": s.polarities.iter().map(|p| *p as i32).collect::<Vec<_>>(),
+            "magnification": s.magnification,
+        }))
+    })?;
+    Ok(doc.to_string())
+}
+
+/// Selected runs of a study: `runs_json` is a list of [record, set, polarity,
+/// scale]. Each run is one combination of the library's own study functions on a
+/// one-combination copy of the study: with `sensitivity`, `run_study` (the
+/// façade table's run, repeated at rtol × 100 and / 100 for `well_conditioned`),
+/// without it `run_ida` (one integration, the IDA's point). Runs go over the
+/// rayon pool when `parallel`, else one after the other (one Dask worker thread).
+#[pyfunction]
+#[pyo3(signature = (study, runs_json, sensitivity=true, parallel=true))]
+fn facade_runs(py: Python<'_>, study: PathBuf, runs_json: &str, sensitivity: bool, parallel: bool) -> PyResult<String> {
+    let runs_json = runs_json.to_string();
+    let doc = guarded(py, move || {
+        let study = Study::load(&study)?;
+        let runs: Vec<(String, String, i64, f64)> =
+            serde_json::from_str(&runs_json).context("runs: expected a list of [record, set, polarity, scale]")?;
+        let mut subs = std::collections::HashMap::new();
+        let mut jobs = Vec::with_capacity(runs.len());
+        for (rec, set, pol, scale) in &runs {
+            let r = study.records.iter().position(|x| &x.name == rec).ok_or_else(|| {
+                anyhow!(
+                    "record {rec:?} is not in the study (records: {})",
+                    study.records.iter().map(|x| x.name.as_str()).collect::<Vec<_>>().join(", ")
+                )
+            })?;
+            let s = study.sets.iter().position(|x| &x.name == set).ok_or_else(|| {
+                anyhow!(
+                    "coefficient set {set:?} is not in the study (sets: {})",
+                    study.sets.iter().map(|x| x.name.as_str()).collect::<Vec<_>>().join(", ")
+                )
+            })?;
+            if *pol != 1 && *pol != -1 {
+                bail!("polarity {pol}: expected 1 or -1");
+            }
+            if !(scale.is_finite() && *scale > 0.0) {
+                bail!("scale {scale}: expected a positive number");
+            }
+            subs.entry((r, s, *pol)).or_insert_with(|| Study {
+                records: vec![study.records[r].clone()],
+                sets: vec![study.sets[s].clone()],
+                polarities: vec![*pol as f64],
+                ..study.clone()
+            });
+            jobs.push(((r, s, *pol), *scale));
+        }
+        let one = |(key, scale): &((usize, usize, i64), f64)| -> anyhow::Result<Value> {
+            let sub = &subs[key];
+            Ok(if sensitivity {
+                serde_json::to_value(&run_study(sub, *scale, false, &|| {})[0])?
+            } else {
+                serde_json::to_value(&run_ida(sub, &[*scale], &|| {})[0])?
+            })
+        };
+        let out: Vec<Value> = if parallel {
+            jobs.par_iter().map(one).collect::<anyhow::Result<_>>()?
+        } else {
+            jobs.iter().map(one).collect::<anyhow::Result<_>>()?
+        };
+        Ok(Value::Array(out))
+    })?;
+    Ok(doc.to_string())
+}
+
+/// Deliberately panics (tests check that a panic becomes `RocklabError`).
+#[pyfunction]
+fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
+    guarded(py, || -> anyhow::Result<()> { panic!("test panic") })
+}
+
+/// The extension module.
+#[pymodule]
+fn _rocklab(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("RocklabError", m.py().get_type::<RocklabError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(reduce, m)?)?;
+    m.add_function(wrap_pyfunction!(reduce_log, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(facade, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_scales, m)?)?;
+    m.add_function(wrap_pyfunction!(study_info, m)?)?;
+    m.add_function(wrap_pyfunction!(facade_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
+    Ok(())
+}

@@ -93,18 +93,7 @@ fn build(res: &CampaignResult, name: &'static str, caption: String, cols: &[(&'s
         cols.iter().map(|col| (col.2)(&c)).collect::<Vec<f64>>()
     });
     let mean = res.means.means.map(|m| {
-        let as_c = Coefficients {
-            e: f64::NAN,
-            e_plus: f64::NAN,
-            e_minus: f64::NAN,
-            r: m.r,
-            r_plus: m.r_plus,
-            r_minus: m.r_minus,
-            r1: m.r1,
-            r1_plus: m.r1_plus,
-            r1_minus: m.r1_minus,
-            r2: m.r2,
-        };
+        let as_c = as_coefficients(&m);
         let label = if res.means.left_out.is_empty() {
             "mean".to_string()
         } else {

@@ -35,7 +35,8 @@ pub fn merged_impacts(impact_times: &[f64], dt: f64) -> Option<String> {
 pub fn alternation(v: &[f64]) -> Option<String> {
     v.iter().enumerate().find_map(|(k, &vk)| {
         let want = if k % 2 == 0 { -1.0 } else { 1.0 };
-        (vk * want <= 0.0).then(|| format!("peak {k} ({vk:.1} mm/s) has the wrong sign: the peaks do not alternate"))
+        // A peak that is not a finite number is never ok.
+        (!vk.is_finite() || vk * want <= 0.0).then(|| format!("peak {k} ({vk:.1} mm/s) has the wrong sign: the peaks do not alternate"))
     })
 }
 
@@ -208,6 +209,7 @@ mod tests {
         assert!(alternation(&[-5.0, 4.0, 0.0]).unwrap().contains("peak 2"));
         // The failure of issue #9: a collapsed segment with a peak of 0.00 mm/s.
         assert!(alternation(&[-5.0, 0.0, -3.0]).is_some());
+        assert!(alternation(&[-5.0, f64::NAN, -3.0]).is_some());
     }
 
     #[test]

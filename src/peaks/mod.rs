@@ -337,7 +337,9 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
 /// distribution of width |ÿ| Δt, standard uncertainty |ÿ| Δt / √12 (GUM 4.3.7),
 /// added as an independent variance to each peak. Without it a 200 Hz one-sided
 /// MuJoCo test fitted to the noise level claimed ±0.2 mm/s on peaks that were
-/// 3–16 mm/s off (issue #9); at 1 kHz the term is a few tenths of a percent.
+/// 3–16 mm/s off (issue #9); with it they carry ±2.7 mm/s, which narrows the gap
+/// without closing it (its onsets come up to two samples early). At 1 kHz the
+/// term is a few tenths of a percent.
 fn add_unresolved_contact(cov: &mut [Vec<f64>], m: &model::Model, dt: f64) {
     for (k, row) in cov.iter_mut().enumerate() {
         let t = m.onset(k);

@@ -33,7 +33,10 @@ def test_facade_equals_cli_summary_and_ida(cli, tmp_path):
     expected = json.loads((tmp_path / "summary.json").read_text())
     res = rocklab.facade(STUDY, scales="0.5:1.5:3")
     assert _runs_without_timing(res.summary["runs"]) == _runs_without_timing(expected["runs"])
-    drop = {"runs", "wall_s"}
+    # The binding runs the nominal study and the IDA; the CLI's summary also holds
+    # the ensembles and fragility fits of issue #10, which the binding does not
+    # expose yet (README, "what is next").
+    drop = {"runs", "wall_s", "ensemble", "fragility"}
     assert {k: v for k, v in res.summary.items() if k not in drop} == {k: v for k, v in expected.items() if k not in drop}
     ida = rocklab.read_csv(tmp_path / "ida.csv")
     pd.testing.assert_frame_equal(res.ida, ida, check_exact=True)

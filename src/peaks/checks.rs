@@ -7,6 +7,7 @@
 //! | [`merged_impacts`] | two impacts of the fit are less than 2 samples apart |
 //! | [`alternation`] | the peaks do not alternate inward, outward, … |
 //! | [`energy_gain`] | a peak is faster than the one before by more than 2 % + 3 u (free rocking only loses energy) |
+//! | [`impact_gains_speed`] | the speed after an impact exceeds the speed before it by more than 3 u (e > 1) |
 //! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise |
 //! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
@@ -52,6 +53,26 @@ pub fn energy_gain(v: &[f64], u: &[f64]) -> Option<String> {
                 k + 1,
                 v[k + 1],
                 v[k]
+            )
+        })
+    })
+}
+
+/// An impact only takes speed away: the fitted speed just after impact k may not
+/// exceed the speed before it (e ≤ 1) by more than 3 combined uncertainties. A
+/// fit that needs e > 1 to follow the log has the impacts' timing wrong (a
+/// contact it could not see, issue #9's 200 Hz MuJoCo test).
+pub fn impact_gains_speed(before: &[f64], after: &[Option<f64>], u: &[f64]) -> Option<String> {
+    before.iter().zip(after).enumerate().find_map(|(k, (&vb, va))| {
+        let va = (*va)?;
+        let uk = u.get(k).copied().unwrap_or(0.0);
+        let un = u.get(k + 1).copied().unwrap_or(uk);
+        (va.abs() > vb.abs() + 3.0 * (uk * uk + un * un).sqrt()).then(|| {
+            format!(
+                "impact {k} leaves the wall faster than it found it ({:.1} → {:.1} mm/s, e = {:.3} > 1): the fit cannot place this impact",
+                vb.abs(),
+                va.abs(),
+                va.abs() / vb.abs()
             )
         })
     })
@@ -218,6 +239,16 @@ mod tests {
         assert!(energy_gain(&[-100.0, 60.0, -70.0], &[1.0, 1.0, 1.0]).unwrap().contains("peak 2"));
         // Within the uncertainty it does not trip.
         assert!(energy_gain(&[-100.0, 60.0, -63.0], &[1.0, 1.0, 1.0]).is_none());
+    }
+
+    #[test]
+    fn an_impact_that_gains_speed_trips() {
+        let u = [1.0, 1.0, 1.0];
+        assert!(impact_gains_speed(&[-100.0, 60.0], &[Some(-70.0), Some(50.0)], &u).is_none());
+        let r = impact_gains_speed(&[-100.0, 60.0], &[Some(-70.0), Some(66.0)], &u).unwrap();
+        assert!(r.contains("impact 1") && r.contains("e = 1.100"), "{r}");
+        // Within the uncertainty it does not trip.
+        assert!(impact_gains_speed(&[-100.0, 60.0], &[Some(-70.0), Some(62.0)], &u).is_none());
     }
 
     #[test]

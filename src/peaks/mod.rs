@@ -381,10 +381,13 @@ fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f64, f64)>], 
     let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
     let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
     let resid = fit.residuals();
+    // Impacts 0..n−2: the ones between the peaks the tables use.
+    let after: Vec<Option<f64>> = (0..v.len().saturating_sub(1)).map(|k| m.speeds(k).1).collect();
     let reasons: Vec<String> = [
         checks::merged_impacts(&zeros, dt),
         checks::alternation(&v),
         checks::energy_gain(&v, &u),
+        checks::impact_gains_speed(&v, &after, &u),
         checks::misfit(&resid, sigma),
         checks::structured_near_impacts(&fit.tw, &resid, &onsets, dt, sigma),
         checks::disagreement(&v_onset, &u, local),

@@ -247,7 +247,15 @@ fn md_table_to_html(md: &str, id: &str) -> String {
         let tag = if i == 0 { "th" } else { "td" };
         s.push_str("<tr>");
         for c in cells {
-            s.push_str(&format!("<{tag}>{}</{tag}>", escape(c)));
+            // Markdown's **bold** (the P(overturn) column) as <strong>, not as asterisks.
+            let cell = match c.strip_prefix("**").and_then(|x| x.strip_suffix("**")) {
+                Some(inner) => format!("<strong>{}</strong>", escape(inner)),
+                None => escape(c),
+            };
+            // Cells stay on one line (ranges such as "98.1 %–100.0 %" and times
+            // broke into three-line rows); the headers wrap.
+            let style = if tag == "td" { " style=\"white-space: nowrap\"" } else { "" };
+            s.push_str(&format!("<{tag}{style}>{cell}</{tag}>"));
         }
         s.push_str("</tr>\n");
     }

@@ -451,22 +451,9 @@ impl Study {
         }
         let mut records = Vec::new();
         for r in &raw.record {
-            let format = match r.format.as_deref() {
-                None | Some("auto") => None,
-                Some("esm") => Some(Format::Esm),
-                Some("at2") => Some(Format::At2),
-                Some("cosmos") => Some(Format::Cosmos),
-                Some("two-column") => Some(Format::TwoColumn),
-                Some("one-column") => Some(Format::OneColumn),
-                Some(other) => {
-                    return Err(bad(
-                        path,
-                        format!(
-                            "[[record]] {:?}: format = {other:?}: expected auto, esm, at2, cosmos, two-column or one-column",
-                            r.name
-                        ),
-                    ))
-                }
+            let format = match Format::from_name(r.format.as_deref().unwrap_or("auto")) {
+                Ok(f) => f,
+                Err(e) => return Err(bad(path, format!("[[record]] {:?}: {e}", r.name))),
             };
             let units = r
                 .units
@@ -805,20 +792,7 @@ impl Study {
 /// The ensembles at scale 1: `n` samples per record × polarity row × set.
 /// Returns the rows (record-major, then polarity row, then set) and every sample.
 pub fn run_ensembles(study: &Study, n: usize, tick: &(dyn Fn() + Sync)) -> (Vec<EnsembleRow>, Vec<SampleRun>) {
-    let mut jobs = Vec::new();
-    for record in 0..study.records.len() {
-        for row in study.rows() {
-            for set in 0..study.sets.len() {
-                jobs.push(Job {
-                    record,
-                    set,
-                    row,
-                    scale_idx: 0,
-                    scale: 1.0,
-                });
-            }
-        }
-    }
+    let jobs = jobs_at(study, 0, 1.0);
     let samples = study.run_jobs(&jobs, n, tick);
     let rows = samples
         .chunks(n.max(1))
@@ -836,23 +810,28 @@ pub fn run_ensembles(study: &Study, n: usize, tick: &(dyn Fn() + Sync)) -> (Vec<
 /// IDA with ensembles: `n` samples per record × polarity row × set at each scale
 /// (scale indices 1, 2, … so that no stream is shared with the scale-1 ensemble).
 pub fn run_ida_samples(study: &Study, scales: &[f64], n: usize, tick: &(dyn Fn() + Sync)) -> Vec<SampleRun> {
+    let jobs: Vec<Job> = scales.iter().enumerate().flat_map(|(k, &scale)| jobs_at(study, k + 1, scale)).collect();
+    study.run_jobs(&jobs, n, tick)
+}
+
+/// One job per record × polarity row × set at one scale (record-major, then
+/// polarity row, then set).
+fn jobs_at(study: &Study, scale_idx: usize, scale: f64) -> Vec<Job> {
     let mut jobs = Vec::new();
-    for (k, &scale) in scales.iter().enumerate() {
-        for record in 0..study.records.len() {
-            for row in study.rows() {
-                for set in 0..study.sets.len() {
-                    jobs.push(Job {
-                        record,
-                        set,
-                        row,
-                        scale_idx: k + 1,
-                        scale,
-                    });
-                }
+    for record in 0..study.records.len() {
+        for row in study.rows() {
+            for set in 0..study.sets.len() {
+                jobs.push(Job {
+                    record,
+                    set,
+                    row,
+                    scale_idx,
+                    scale,
+                });
             }
         }
     }
-    study.run_jobs(&jobs, n, tick)
+    jobs
 }
 
 /// A set's fragility: the fit (or why not) and the observed fractions per record ×

@@ -209,15 +209,7 @@ fn load_record(
         .transpose()?;
     match (path, acc) {
         (Some(p), None) => {
-            let format = match format.as_deref() {
-                None | Some("auto") => None,
-                Some("esm") => Some(Format::Esm),
-                Some("at2") => Some(Format::At2),
-                Some("cosmos") => Some(Format::Cosmos),
-                Some("two-column") => Some(Format::TwoColumn),
-                Some("one-column") => Some(Format::OneColumn),
-                Some(o) => bail!("format = {o:?}: expected auto, esm, at2, cosmos, two-column or one-column"),
-            };
+            let format = Format::from_name(format.as_deref().unwrap_or("auto")).map_err(|e| anyhow!(e))?;
             let rec = ground_motion::read(&p, &ReadOptions { format, dt, units })?;
             Ok((p.display().to_string(), rec))
         }

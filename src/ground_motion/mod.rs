@@ -45,6 +45,22 @@ pub enum Format {
     OneColumn,
 }
 
+impl Format {
+    /// The names a study file or the Python API uses for a format: `Ok(None)` for
+    /// "auto" (detect it), an error naming the accepted names otherwise.
+    pub fn from_name(name: &str) -> Result<Option<Format>, String> {
+        match name {
+            "auto" => Ok(None),
+            "esm" => Ok(Some(Format::Esm)),
+            "at2" => Ok(Some(Format::At2)),
+            "cosmos" => Ok(Some(Format::Cosmos)),
+            "two-column" => Ok(Some(Format::TwoColumn)),
+            "one-column" => Ok(Some(Format::OneColumn)),
+            other => Err(format!("format = {other:?}: expected auto, esm, at2, cosmos, two-column or one-column")),
+        }
+    }
+}
+
 /// A uniformly sampled record, in m/s².
 #[derive(Debug, Clone)]
 pub struct Record {

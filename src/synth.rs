@@ -378,7 +378,9 @@ pub fn draw(seed: u64, family: Family) -> Synthetic {
     }
 }
 
-pub fn draw_spec_pub(seed: u64, family: Family) -> TestSpec {
+/// The test a seed gives before the resolvability check (the `seed` a [`Scored`]
+/// reports), to replay one test of a draw.
+pub fn spec_for_seed(seed: u64, family: Family) -> TestSpec {
     draw_spec(seed, family)
 }
 

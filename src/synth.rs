@@ -5,7 +5,7 @@
 //! # Two contact models
 //! Both integrate paper Eq. 1 without ground motion, per unit I_0, with s = sign θ:
 //!
-//!   θ'' = −p² s sin(α − sθ) − [θ < 0] κ θ                                    (Eq. 1)
+//!   θ'' = −p² s sin(α − sθ) − \[θ < 0\] κ θ                                    (Eq. 1)
 //!
 //! - [`Contact::Rigid`]: the paper's idealisation. Impacts are instantaneous,
 //!   θ' ← e_k θ' at every crossing of θ = 0, and e_k may change impact by impact.
@@ -16,8 +16,8 @@
 //!   c_f acts while both edges bear, and the transverse walls are a
 //!   compression-only spring–dashpot:
 //!
-//!   θ'' = −p² (sin α cos θ · sat(θ/θ_c) − sin θ) − c_f θ' [|θ| < θ_c]
-//!   + max(0, −κ θ − c_w θ') [θ < 0]
+//!   θ'' = −p² (sin α cos θ · sat(θ/θ_c) − sin θ) − c_f θ' \[|θ| < θ_c\]
+//!   + max(0, −κ θ − c_w θ') \[θ < 0\]
 //!
 //!   with sat(u) = clamp(u, −1, 1) (the rigid model's s sin(α − sθ) for |θ| ≥ θ_c).
 //!   An impact then lasts 2θ_c/|θ'|, loses about 1 − √(1 − 4 c_f θ_c / |θ'|) of the
@@ -284,9 +284,6 @@ fn compliant_motion(spec: &TestSpec, theta_c: f64, c_floor: f64, c_wall: f64) ->
         }
         if th < 0.0 && kappa > 0.0 {
             a += (-kappa * th - c_wall * y[1]).max(0.0);
-        }
-        if th >= 0.0 || kappa <= 0.0 {
-            // Two-sided, or outward: no wall force.
         }
         [y[1], a]
     };

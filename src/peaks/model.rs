@@ -401,7 +401,7 @@ pub fn damped_arc(lambda: f64, gamma: f64, f: f64, tau: f64, t_len: f64) -> (f64
 
 /// ψ(τ) of [`damped_arc`] by its power series (|λ| τ² small).
 fn step_response_series(lambda: f64, gamma: f64, x: f64) -> f64 {
-    let (mut a0, mut a1, mut a2) = (0.0, 0.0, 0.5);
+    let (mut a1, mut a2) = (0.0, 0.5);
     let mut sum = 0.5 * x * x;
     let mut pw = x * x;
     for n in 1..40 {
@@ -409,37 +409,13 @@ fn step_response_series(lambda: f64, gamma: f64, x: f64) -> f64 {
         let next = (-2.0 * gamma * (n + 1) as f64 * a2 - lambda * a1) / ((n + 2) * (n + 1)) as f64;
         pw *= x;
         sum += next * pw;
-        a0 = a1;
         a1 = a2;
         a2 = next;
         if (next * pw).abs() < 1e-17 * sum.abs() {
             break;
         }
     }
-    let _ = a0;
     sum
-}
-
-/// The inward arc of one-sided rocking between two impacts, per unit A p²:
-/// g = (cos(√λ τ) − cos(√λ h)) / (λ cos(√λ h)) with h = T/2 (so L θ = −A p² g),
-/// and dg/dτ; cosh for λ < 0 (gravity stronger than the spring) and the series
-/// (h² − τ²)/2 + λ [(h² − τ²) h²/4 − (h⁴ − τ⁴)/24] near λ = 0, so the arc is smooth
-/// in λ across 0.
-pub fn spring_arc(l: f64, tau: f64, h: f64) -> (f64, f64) {
-    if (l * h * h).abs() < 1e-4 {
-        let (h2, t2) = (h * h, tau * tau);
-        let g = 0.5 * (h2 - t2) + l * ((h2 - t2) * h2 / 4.0 - (h2 * h2 - t2 * t2) / 24.0);
-        let dg = -tau + l * (-tau * h2 / 2.0 + tau * t2 / 6.0);
-        (g, dg)
-    } else if l > 0.0 {
-        let w = l.sqrt();
-        let den = (w * h).cos();
-        (((w * tau).cos() - den) / (l * den), -(w * tau).sin() / (w * den))
-    } else {
-        let v = (-l).sqrt();
-        let den = (v * h).cosh();
-        (((v * tau).cosh() - den) / (l * den), -(v * tau).sinh() / (v * den))
-    }
 }
 
 /// A fitted model with what the fit knows of its own precision.
@@ -573,6 +549,29 @@ mod tests {
         assert!((m0.arc(1, 1.5).1 - v0).abs() < 1e-12);
         assert!(v1.abs() < v0.abs(), "{v1} {v0}");
         assert!((m1.arc(1, 1.49).1 - v1).abs() < 1e-9);
+    }
+
+    /// The lossless inward arc (the estimator's before issue #9, the reference for
+    /// γ = 0): the inward arc of one-sided rocking between two impacts, per unit A p²:
+    /// g = (cos(√λ τ) − cos(√λ h)) / (λ cos(√λ h)) with h = T/2 (so L θ = −A p² g),
+    /// and dg/dτ; cosh for λ < 0 (gravity stronger than the spring) and the series
+    /// (h² − τ²)/2 + λ [(h² − τ²) h²/4 − (h⁴ − τ⁴)/24] near λ = 0, so the arc is smooth
+    /// in λ across 0.
+    fn spring_arc(l: f64, tau: f64, h: f64) -> (f64, f64) {
+        if (l * h * h).abs() < 1e-4 {
+            let (h2, t2) = (h * h, tau * tau);
+            let g = 0.5 * (h2 - t2) + l * ((h2 - t2) * h2 / 4.0 - (h2 * h2 - t2 * t2) / 24.0);
+            let dg = -tau + l * (-tau * h2 / 2.0 + tau * t2 / 6.0);
+            (g, dg)
+        } else if l > 0.0 {
+            let w = l.sqrt();
+            let den = (w * h).cos();
+            (((w * tau).cos() - den) / (l * den), -(w * tau).sin() / (w * den))
+        } else {
+            let v = (-l).sqrt();
+            let den = (v * h).cosh();
+            (((v * tau).cosh() - den) / (l * den), -(v * tau).sinh() / (v * den))
+        }
     }
 
     /// The damped arc is the lossless spring arc at γ = 0, hits both zeros, solves

@@ -198,7 +198,7 @@ fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: b
     let lever = inp.phys.lever_arm_mm;
     let hold = median(&yw[..tw.partition_point(|&v| v < t_dep).max(1)]) - rest;
     let p = inp.phys.p_guess;
-    let a = amplitude_guess(tw, yw, rest, inp.crossings, p, one_sided).unwrap_or(lever * 0.15);
+    let a = amplitude_guess(tw, yw, rest, inp.crossings, p).unwrap_or(lever * 0.15);
     let h0 = hold.max(1e-3);
     let a0 = a.max(1.5 * h0);
     let t0 = inp.crossings[0];
@@ -227,7 +227,7 @@ fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: b
 
 /// A = L tan α_e from the first full outward arc (between crossings 1 and 2): a
 /// gravity arc of length T and apex height h has h = A (1 − 1/cosh(p T/2)).
-fn amplitude_guess(tw: &[f64], yw: &[f64], rest: f64, crossings: &[f64], p: f64, _one_sided: bool) -> Option<f64> {
+fn amplitude_guess(tw: &[f64], yw: &[f64], rest: f64, crossings: &[f64], p: f64) -> Option<f64> {
     let (a, b) = (*crossings.get(1)?, *crossings.get(2)?);
     let i0 = tw.partition_point(|&v| v < a);
     let i1 = tw.partition_point(|&v| v < b);

@@ -75,6 +75,21 @@ fn random_rigid_tests_small_draw() {
     assert!(rate >= 0.975, "success rate {rate}");
 }
 
+/// The five tests of the full draw that were missed before the large-angle
+/// correction of the gravity arcs and the rejection of spikes next to impacts
+/// (two 0.7 α releases whose large arcs the small-angle model could not follow,
+/// so that contact phases absorbed the misfit; three 100 Hz logs with a spike
+/// beside an impact): each is now ok and within 1 pp.
+#[test]
+fn tests_once_missed_are_reduced() {
+    use rocklab::synth::{generate, spec_for_seed};
+    for seed in [1137003411, 1185003555, 1229003687, 1231003695, 1379004137] {
+        let s = score(&generate(&spec_for_seed(seed, Family::Rigid)));
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status == "ok" && w <= 1.0, "seed {seed}: {w} pp, {}", s.status);
+    }
+}
+
 /// 12 compliant draws: none silently wrong (the full draw gives the rate).
 #[test]
 fn random_compliant_tests_small_draw() {
@@ -84,16 +99,15 @@ fn random_compliant_tests_small_draw() {
 }
 
 /// The issue's draw: 500 resolvable tests of the idealised model. Measured
-/// 99.0 % ok and within 1 pp (the issue asks 99.5 %: see the README), no test
-/// more than 5 pp off with status ok. The bound is the measured rate: the draw
-/// is seeded, so a lower rate is a regression.
+/// 100 % ok and within 1 pp (worst 0.86 pp), no test more than 5 pp off with
+/// status ok. The bound is the issue's 99.5 %.
 #[test]
 #[ignore = "the full draw of issue #9: run in release (see the module docs)"]
 fn random_rigid_tests_full_draw() {
     let scored = run(Family::Rigid, 1000..1500);
     let (rate, silent) = summarise("rigid", &scored);
     assert_eq!(silent, 0);
-    assert!(rate >= 0.99, "success rate {rate}");
+    assert!(rate >= 0.995, "success rate {rate}");
 }
 
 /// 200 tests with finite-duration lossy contacts (the compliant generator): none

@@ -1,0 +1,68 @@
+//! The second estimate of each peak and the plausibility checks of one
+//! analysis ([`super::checks`]).
+
+use super::segments::SegmentFit;
+use super::{checks, Peak, Quality};
+
+/// The second estimate of each peak: the end of free arc k re-fitted from its own
+/// samples (the later half of the arc, at least 4 samples) by [`checks::local_slope`].
+pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<(f64, f64)>> {
+    let m = fit.model();
+    (0..n.min(m.m()))
+        .map(|k| {
+            let start = if k == 0 { m.release_time() } else { m.release_from_contact(k - 1) };
+            let end = m.onset(k);
+            let from = start + 0.5 * (end - start);
+            let i0 = fit.tw.partition_point(|&v| v < from);
+            let i1 = fit.tw.partition_point(|&v| v < end);
+            let i0 = i0.min(i1.saturating_sub(4)).max(fit.tw.partition_point(|&v| v < start));
+            let inward_spring = m.one_sided && k % 2 == 1;
+            let lambda = if inward_spring { m.lambda().unwrap_or(0.0) } else { -m.p().powi(2) };
+            let (slope, u) = checks::local_slope(&fit.tw[i0..i1], &fit.yw[i0..i1], end, lambda, sigma)?;
+            Some((slope, u))
+        })
+        .collect()
+}
+
+/// Run every check of [`checks`] on a fit.
+pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f64, f64)>], dt: f64, sigma: f64) -> Quality {
+    let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
+    let u: Vec<f64> = peaks.iter().map(|p| p.velocity_u_mm_s.unwrap_or(0.0)).collect();
+    let m = fit.model();
+    // Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
+    let spring: Vec<bool> = (0..m.m()).map(|s| m.one_sided && s % 2 == 1).collect();
+    // The local re-fit estimates the free arc's slope at the onset of contact.
+    let v_onset: Vec<f64> = (0..v.len()).map(|k| m.speeds(k).0).collect();
+    let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
+    let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
+    let resid = fit.residuals();
+    // Impacts 0..n−2: the ones between the peaks the tables use.
+    let after: Vec<Option<f64>> = (0..v.len().saturating_sub(1)).map(|k| m.speeds(k).1).collect();
+    let reasons: Vec<String> = [
+        checks::merged_impacts(&zeros, dt),
+        checks::alternation(&v),
+        checks::energy_gain(&v, &u),
+        checks::impact_gains_speed(&v, &after, &u),
+        checks::misfit(&resid, sigma),
+        checks::structured_near_impacts(&fit.tw, &resid, &onsets, dt, sigma),
+        checks::disagreement(&v_onset, &u, local),
+        m.contact_windows().and_then(|w| {
+            let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
+            let windows = if m.layout.by_direction { &w[..] } else { &w[..1] };
+            checks::contact_too_long(windows, &arcs, &spring)
+        }),
+        if fit.contacts {
+            checks::contact_overshoot(&v, &v_onset, &u, &spring)
+        } else {
+            None
+        },
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if reasons.is_empty() {
+        Quality::Ok
+    } else {
+        Quality::Suspect(reasons)
+    }
+}

@@ -3,10 +3,7 @@
 //! (manifest, input files with size and SHA-256, e_H and its source, the
 //! differentiation method, the tool's version, every warning). Prints on A4.
 
-use std::path::Path;
-
-use sha2::{Digest, Sha256};
-
+use super::campaign::{Sources, TestFigures};
 use super::tables::{to_html, Table};
 use crate::reduce::CampaignResult;
 
@@ -20,7 +17,7 @@ body { font-family: "DejaVu Sans", Arial, sans-serif; font-size: 10.5pt; color: 
 h1 { font-size: 17pt; margin-bottom: 0.2em; } h2 { font-size: 13.5pt; border-bottom: 1px solid #999; margin-top: 1.6em; } h3 { font-size: 11.5pt; }
 table { border-collapse: collapse; margin: 0.8em 0; } caption { caption-side: bottom; text-align: left; font-size: 9pt; padding-top: 0.3em; }
 table.paper { border-top: 2px solid #222; border-bottom: 2px solid #222; } table.paper thead th { border-bottom: 1px solid #222; }
-th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child { text-align: left; }
+th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child, th.l, td.l { text-align: left; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; } td.suspect { color: #a60; text-align: left; font-size: 9pt; } td.ok { color: #060; text-align: left; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
 pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; }
@@ -90,6 +87,11 @@ impl Page {
         s.push_str("</tbody></table>\n");
         self.body.push_str(&s);
     }
+    /// The provenance table: every input with its path, size and SHA-256.
+    pub fn provenance(&mut self, inputs: &[super::InputFile]) {
+        let rows: Vec<Vec<String>> = inputs.iter().map(|f| f.row()).collect();
+        self.table("meta", &["input", "file", "size", "SHA-256"], &rows);
+    }
     pub fn finish(self) -> String {
         format!(
             "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{CSS}</style></head>\n<body>\n{}\n<p class=\"meta\">rocklab {} — Giresini &amp; Croce, COMPDYN 2021.</p>\n{CHECK}\n</body></html>\n",
@@ -100,19 +102,8 @@ impl Page {
     }
 }
 
-/// Size and SHA-256 of a file (hex), or the error.
-pub fn file_facts(path: &Path) -> (String, String) {
-    match std::fs::read(path) {
-        Ok(b) => (
-            format!("{} bytes", b.len()),
-            Sha256::digest(&b).iter().map(|x| format!("{x:02x}")).collect(),
-        ),
-        Err(e) => ("—".into(), format!("unreadable: {e}")),
-    }
-}
-
 /// The reduce report (plus extra sections, e.g. the calibration).
-pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String, String)], extra: &[String]) -> String {
+pub fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: &[String], sources: &Sources) -> String {
     let c = &res.campaign;
     let mut page = Page::new(&format!("{} — coefficients of restitution ({} rocking)", c.name, c.rocking.as_str()));
     page.p(&format!(
@@ -155,22 +146,23 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
         page.raw(x);
     }
     page.h2("Plots");
-    for (id, motion, ratios) in svgs {
+    for (id, motion, ratios) in figs {
         page.h3(&format!("Test {id}"));
         page.figure(
-            motion,
+            &motion.svg,
             &format!("Test {id}: displacement and velocity with the velocity peaks marked (paper Fig. 3/4)."),
         );
-        page.figure(ratios, &format!("Test {id}: local ratios of Eq. 3 and their mean (paper Fig. 5)."));
+        page.figure(&ratios.svg, &format!("Test {id}: local ratios of Eq. 3 and their mean (paper Fig. 5)."));
     }
+    provenance(&mut page, res, sources);
+    page.finish()
+}
+
+/// The provenance section of the reduce report: the inputs with their checksums,
+/// what reading and fitting each log noted, every warning, the tool, the manifest.
+fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
     page.h2("Provenance");
-    let (size, sha) = file_facts(&c.manifest_path);
-    let mut files = vec![vec!["manifest".to_string(), c.manifest_path.display().to_string(), size, sha]];
-    for t in &res.tests {
-        let (size, sha) = file_facts(&t.spec.file);
-        files.push(vec![t.spec.id.clone(), t.spec.file.display().to_string(), size, sha]);
-    }
-    page.table("meta", &["input", "file", "size", "SHA-256"], &files);
+    page.provenance(&sources.files);
     let mut notes = Vec::new();
     for t in &res.tests {
         if let Ok(r) = &t.result {
@@ -208,6 +200,5 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
         res.options.method.describe()
     ));
     page.h3("Manifest");
-    page.pre(&std::fs::read_to_string(&c.manifest_path).unwrap_or_default());
-    page.finish()
+    page.pre(&sources.manifest);
 }

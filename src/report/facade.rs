@@ -157,7 +157,7 @@ fn row_runs<'a>(study: &Study, runs: &'a [StudyRun], record: &str, polarity: i8)
 
 /// The nominal runs: per record and polarity, PGA, PGV, each set's peak θ/α or
 /// overturning time, and the ratio of the second set's peak to the first's.
-fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
+pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
     let r = |k: &str, l: &str| Column::new(k, l, Align::Right);
     let mut columns = vec![
         Column::new("record", "record", Align::Left),

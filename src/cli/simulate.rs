@@ -109,12 +109,11 @@ fn coefficients_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result
     })
 }
 
-pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
-    let block = BlockSpec::load(&a.block)?;
-    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+/// The run's settings from the arguments and the block file's defaults, validated.
+fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec> {
     let (e_in, e_out) = match &a.calibration {
         Some(file) => rocklab::facade::read_calibration(file)?,
-        None => coefficients_from_args(&a, &block)?,
+        None => coefficients_from_args(a, block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
     if a.polarity != 1 && a.polarity != -1 {
@@ -123,18 +122,23 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     if !(a.scale.is_finite() && a.scale > 0.0) {
         bail!("--scale {}: expected a positive number", a.scale);
     }
-    let limit = a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha);
-    let spec = RunSpec {
+    Ok(RunSpec {
         e_in,
         e_out,
         scale: a.scale,
         polarity: a.polarity as f64,
-        overturn_limit: limit,
+        overturn_limit: a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha),
         t_extra: a.t_extra,
         rtol: a.rtol,
         atol: a.atol,
         keep_history: true,
-    };
+    })
+}
+
+pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
+    let block = BlockSpec::load(&a.block)?;
+    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let spec = spec_from_args(&a, &block)?;
     let (summary, sim) = run(&block, &record, &spec);
     let alpha = block.block.alpha;
     let mut files = Files::default();

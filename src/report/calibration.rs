@@ -152,8 +152,8 @@ fn figures(res: &CampaignResult, cal: &Calibration, n_impacts: usize) -> Result<
         let Some(w) = crate::calibrate::window(&f.id, r, t.spec.lever_arm_m * 1e3, n_impacts) else {
             continue;
         };
-        // The late half-cycles: from the impact halfway through the window.
-        let late_from = r.analysis.impacts.get(n_impacts / 2).map(|i| i.time_s);
+        // The late half-cycles: every arc after the first two impacts.
+        let late_from = r.analysis.impacts.get(1).map(|i| i.time_s);
         figs.push(Captioned {
             stem: format!("{}_replay", f.id),
             caption: format!(
@@ -173,41 +173,47 @@ pub fn replay_figure(f: &TestFit, w: &TestWindow, late_from: Option<f64>) -> Res
     let pts = |y: &dyn Fn(usize) -> f64, keep: &dyn Fn(f64) -> bool| -> Vec<(f64, f64)> {
         (0..n).filter(|&i| keep(w.t[i])).map(|i| (w.t[i], y(i))).collect()
     };
-    let (measured, replay) = (|i: usize| w.x_mm[i], |i: usize| f.replay_mm[i]);
+    let both = |keep: &dyn Fn(f64) -> bool| {
+        vec![
+            Series::line("measured", plots::GREY, pts(&|i| w.x_mm[i], keep)),
+            Series::line("solver replay", plots::RED, pts(&|i| f.replay_mm[i], keep)),
+        ]
+    };
     let all = |_: f64| true;
+    let title = format!("Test {}: measured and replayed (e_in {:.3}, e_out {:.3})", f.id, f.e_in, f.e_out);
+    let residual = vec![Series::line("measured − replay", plots::BLUE, pts(&|i| w.x_mm[i] - f.replay_mm[i], &all))];
     let mut panels = vec![
-        Panel {
-            title: format!("Test {}: measured and replayed (e_in {:.3}, e_out {:.3})", f.id, f.e_in, f.e_out),
-            x_label: "time (s)".into(),
-            y_label: "displacement (mm)".into(),
-            series: vec![
-                Series::line("measured", plots::GREY, pts(&measured, &all)),
-                Series::line("solver replay", plots::RED, pts(&replay, &all)),
-            ],
-            ..Panel::default()
-        },
-        Panel {
-            title: format!("residual (RMS {:.3} mm)", f.rms_mm),
-            x_label: "time (s)".into(),
-            y_label: "mm".into(),
-            series: vec![Series::line("measured − replay", plots::BLUE, pts(&|i| w.x_mm[i] - f.replay_mm[i], &all))],
-            ..Panel::default()
-        },
+        Panel::new(title, "time (s)", "displacement (mm)", both(&all)),
+        Panel::new(format!("residual (RMS {:.3} mm)", f.rms_mm), "time (s)", "mm", residual),
     ];
     if let Some(t0) = late_from {
-        let late = |t: f64| t >= t0;
-        panels.push(Panel {
-            title: format!("late half-cycles (from {t0:.2} s), enlarged"),
-            x_label: "time (s)".into(),
-            y_label: "displacement (mm)".into(),
-            series: vec![
-                Series::line("measured", plots::GREY, pts(&measured, &late)),
-                Series::line("solver replay", plots::RED, pts(&replay, &late)),
-            ],
-            ..Panel::default()
-        });
+        let late = move |t: f64| t >= t0;
+        panels.push(Panel::new(
+            format!("late half-cycles (from {t0:.2} s), enlarged"),
+            "time (s)",
+            "displacement (mm)",
+            both(&late),
+        ));
     }
     plots::render(&panels, 1000, 320)
+}
+
+/// The y range of the coefficient plot: every interval and the mean, with a
+/// third of the span free above them for the legend.
+fn legend_room(cal: &Calibration) -> (f64, f64) {
+    let ends = cal
+        .tests
+        .iter()
+        .flat_map(|t| t.ci95_e_in.into_iter().chain(t.ci95_e_out))
+        .chain([cal.e_in]);
+    let (lo, hi) = ends
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let span = (hi - lo).max(0.05);
+    (lo - 0.08 * span, hi + 0.5 * span)
 }
 
 /// The fitted coefficients per test (named on the x axis) with their 95 %
@@ -238,6 +244,7 @@ pub fn coefficients_figure(cal: &Calibration) -> Result<Figure, ReportError> {
         series,
         hline: Some((cal.e_in, format!("mean e_in {:.3}", cal.e_in))),
         x_range: Some((0.5, cal.tests.len() as f64 + 0.5)),
+        y_range: Some(legend_room(cal)),
         x_names: cal.tests.iter().map(|t| t.id.clone()).collect(),
     };
     plots::render(&[panel], 900, 450)

@@ -101,31 +101,25 @@ fn test_plots(id: &str, r: &Reduced, e_h: f64) -> Result<(Figure, Figure), Repor
     }
     vel.push(Series::dots("peaks v_k", plots::RED, peaks));
     let motion = [
-        Panel {
-            title: format!("Test {id}: displacement at the sensor (outward +)"),
-            x_label: "time (s)".into(),
-            y_label: "displacement (mm)".into(),
-            series: disp,
-            ..Panel::default()
-        },
-        Panel {
-            title: format!("Test {id}: velocity and its peaks"),
-            x_label: "time (s)".into(),
-            y_label: "velocity (mm/s)".into(),
-            series: vel,
-            ..Panel::default()
-        },
+        Panel::new(
+            format!("Test {id}: displacement at the sensor (outward +)"),
+            "time (s)",
+            "displacement (mm)",
+            disp,
+        ),
+        Panel::new(format!("Test {id}: velocity and its peaks"), "time (s)", "velocity (mm/s)", vel),
     ];
     let motion_fig = plots::render(&motion, 1000, 340)?;
     let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
     let ratios = [Panel {
-        title: format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
-        x_label: "impact".into(),
-        y_label: "ratio".into(),
-        series: vec![Series::dots("local ratio", plots::RED, local)],
         hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
-        ..Panel::default()
+        ..Panel::new(
+            format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
+            "impact",
+            "ratio",
+            vec![Series::dots("local ratio", plots::RED, local)],
+        )
     }];
     let ratios_fig = plots::render(&ratios, 800, 400)?;
     Ok((motion_fig, ratios_fig))

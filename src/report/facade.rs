@@ -11,6 +11,9 @@ use crate::outcomes::{find_run, ida_curve, ida_fractions, polarity_key};
 
 type Result<T> = std::result::Result<T, ReportError>;
 
+/// The x axis of the IDA plots.
+const SCALE_AXIS: &str = "scale factor (× record, magnification included)";
+
 const COLORS: [plots::RGBColor; 4] = [plots::RED, plots::BLUE, plots::GREEN, plots::ORANGE];
 
 /// What the study's core step computed.
@@ -337,13 +340,12 @@ fn ida_figures(study: &Study, scales: &[f64], pts: &[IdaPoint], files: &mut File
         frac_series.push(Series::line(&set.name, COLORS[si % COLORS.len()], points));
         figs.push(ida_set_figure(study, set, pts)?);
     }
-    let panel = Panel {
-        title: "Fraction of records × polarities that overturn".into(),
-        x_label: "scale factor (× record, magnification included)".into(),
-        y_label: "fraction overturned".into(),
-        series: frac_series,
-        ..Panel::default()
-    };
+    let panel = Panel::new(
+        "Fraction of records × polarities that overturn",
+        SCALE_AXIS,
+        "fraction overturned",
+        frac_series,
+    );
     figs.push(Captioned {
         stem: "ida_fraction".into(),
         caption: "Fraction of the records × polarities that overturn at each scale.".into(),
@@ -370,13 +372,12 @@ fn ida_set_figure(study: &Study, set: &CoefficientSet, pts: &[IdaPoint]) -> Resu
             });
         }
     }
-    let panel = Panel {
-        title: format!("IDA, {}: max θ/α against scale (1 = overturned)", set.name),
-        x_label: "scale factor (× record, magnification included)".into(),
-        y_label: "max θ/α".into(),
+    let panel = Panel::new(
+        format!("IDA, {}: max θ/α against scale (1 = overturned)", set.name),
+        SCALE_AXIS,
+        "max θ/α",
         series,
-        ..Panel::default()
-    };
+    );
     Ok(Captioned {
         stem: format!("ida_{}", set.name),
         caption: format!(
@@ -488,24 +489,39 @@ fn ensemble_csv(rows: &[EnsembleRow], nominal: &[StudyRun]) -> Result<Vec<u8>> {
     ])?;
     for r in rows {
         let st = &r.stats;
-        w.write_record([
-            r.record.clone(),
-            r.polarity.map_or("random".to_string(), |p| p.to_string()),
-            r.coefficients.clone(),
-            st.samples.to_string(),
-            st.overturned.to_string(),
-            st.p_overturn.to_string(),
-            st.p_overturn_ci95[0].to_string(),
-            st.p_overturn_ci95[1].to_string(),
-            st.verdict.to_string(),
-            st.max_theta_over_alpha_median.to_string(),
-            st.max_theta_over_alpha_p05.to_string(),
-            st.max_theta_over_alpha_p95.to_string(),
-            st.overturn_time_median_s.map(|t| t.to_string()).unwrap_or_default(),
-            nominal_of(r, nominal),
-        ])?;
+        let mut fields = place(&r.record, r.polarity, &r.coefficients);
+        fields.extend([st.samples, st.overturned].map(|n| n.to_string()));
+        fields.extend(texts(&[st.p_overturn, st.p_overturn_ci95[0], st.p_overturn_ci95[1]]));
+        fields.push(st.verdict.to_string());
+        fields.extend(texts(&[
+            st.max_theta_over_alpha_median,
+            st.max_theta_over_alpha_p05,
+            st.max_theta_over_alpha_p95,
+        ]));
+        fields.extend([optional(st.overturn_time_median_s), nominal_of(r, nominal)]);
+        w.write_record(&fields)?;
     }
     csv_bytes(w)
+}
+
+/// The first fields of an ensemble's row: record, polarity ("random" when drawn
+/// per sample), coefficient set.
+fn place(record: &str, polarity: Option<i8>, set: &str) -> Vec<String> {
+    vec![
+        record.to_string(),
+        polarity.map_or("random".to_string(), |p| p.to_string()),
+        set.to_string(),
+    ]
+}
+
+/// Numbers at full precision.
+fn texts(v: &[f64]) -> impl Iterator<Item = String> + '_ {
+    v.iter().map(|x| x.to_string())
+}
+
+/// A number at full precision, or an empty field.
+fn optional(v: Option<f64>) -> String {
+    v.map(|t| t.to_string()).unwrap_or_default()
 }
 
 /// samples.csv: every sample, where it sits, its drawn inputs and its outcome.
@@ -533,27 +549,15 @@ fn samples_csv(samples: &[SampleRun]) -> Result<Vec<u8>> {
     ])?;
     for s in samples {
         let x = &s.inputs;
-        let bed = |f: fn((f64, f64)) -> f64| x.spring_bed.map(|b| f(b).to_string()).unwrap_or_default();
-        w.write_record([
-            s.record.clone(),
-            s.row_polarity.map_or("random".into(), |p| p.to_string()),
-            s.coefficients.clone(),
-            s.scale.to_string(),
-            s.sample.to_string(),
-            s.im.to_string(),
-            x.magnification.to_string(),
-            x.polarity.to_string(),
-            x.r_m.to_string(),
-            x.alpha.to_string(),
-            x.i0.to_string(),
-            bed(|b| b.0),
-            bed(|b| b.1),
-            x.e_in.to_string(),
-            x.e_out.to_string(),
-            s.outcome.overturned.to_string(),
-            s.outcome.overturn_time_s.map(|t| t.to_string()).unwrap_or_default(),
-            s.outcome.max_theta_over_alpha.to_string(),
-        ])?;
+        let mut fields = place(&s.record, s.row_polarity, &s.coefficients);
+        fields.push(s.scale.to_string());
+        fields.push(s.sample.to_string());
+        fields.extend(texts(&[s.im, x.magnification, x.polarity, x.r_m, x.alpha, x.i0]));
+        fields.extend([optional(x.spring_bed.map(|b| b.0)), optional(x.spring_bed.map(|b| b.1))]);
+        fields.extend(texts(&[x.e_in, x.e_out]));
+        fields.push(s.outcome.overturned.to_string());
+        fields.extend([optional(s.outcome.overturn_time_s), s.outcome.max_theta_over_alpha.to_string()]);
+        w.write_record(&fields)?;
     }
     csv_bytes(w)
 }

@@ -67,8 +67,23 @@ pub struct Panel {
     pub hline: Option<(f64, String)>,
     /// Fixed x range (otherwise from the data).
     pub x_range: Option<(f64, f64)>,
+    /// Fixed y range (otherwise from the data), e.g. to leave the legend room.
+    pub y_range: Option<(f64, f64)>,
     /// Names of the categories at x = 1, 2, … (the x axis shows them instead of numbers).
     pub x_names: Vec<String>,
+}
+
+impl Panel {
+    /// A panel of `series` with its title and axis labels (ranges from the data).
+    pub fn new(title: impl Into<String>, x_label: &str, y_label: &str, series: Vec<Series>) -> Panel {
+        Panel {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series,
+            ..Panel::default()
+        }
+    }
 }
 
 /// The x-axis label at `x`: the name of the category at that integer, else nothing.
@@ -110,10 +125,8 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) 
 where
     DB::ErrorType: 'static,
 {
-    let ((mut x0, mut x1), (y0, y1)) = bounds(panel);
-    if let Some((a, b)) = panel.x_range {
-        (x0, x1) = (a, b);
-    }
+    let (x, y) = bounds(panel);
+    let ((x0, x1), (y0, y1)) = (panel.x_range.unwrap_or(x), panel.y_range.unwrap_or(y));
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 18))
         .margin(8)

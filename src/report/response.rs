@@ -47,20 +47,17 @@ pub fn response_panels(title: &str, runs: &[Run], alpha: f64, ag: &[(f64, f64)])
         .collect();
     vec![
         Panel {
-            title: format!("{title}: normalised rotation"),
-            x_label: "time (s)".into(),
-            y_label: "θ/α".into(),
-            series,
             x_range: span,
-            ..Panel::default()
+            ..Panel::new(format!("{title}: normalised rotation"), "time (s)", "θ/α", series)
         },
         Panel {
-            title: "ground acceleration (scaled)".into(),
-            x_label: "time (s)".into(),
-            y_label: "ü_g (g)".into(),
-            series: vec![Series::line("ü_g", BLACKISH, ag.to_vec())],
             x_range: span,
-            ..Panel::default()
+            ..Panel::new(
+                "ground acceleration (scaled)",
+                "time (s)",
+                "ü_g (g)",
+                vec![Series::line("ü_g", BLACKISH, ag.to_vec())],
+            )
         },
     ]
 }

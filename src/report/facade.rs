@@ -110,6 +110,8 @@ fn signed(p: i8) -> String {
 fn facade_page(study: &Study, tables: &[Table], figs: &Figs, inputs: &[InputFile]) -> String {
     let b = &study.block.block;
     let mut page = super::html::Page::new(&format!("{} — Housner against calibrated coefficients", study.name));
+    // The ensembles' table has ten columns whose cells stay on one line.
+    page.widen();
     page.p(&format!(
         "Block: {} (α = {} rad, R = {} m, I_0 = {:.4e} kg m², p² = {:.4} s⁻²). Ground motions ×{}; polarities {}; overturning at θ = {} rad; integration rtol {:e}. Housner's e_H by Eq. 2 with α = {}: {:.3}.",
         study.block.name, b.alpha, b.r_m, b.i0, b.p2(), study.magnification,

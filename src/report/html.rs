@@ -14,10 +14,12 @@ pub fn escape(s: &str) -> String {
 
 const CSS: &str = r#"
 body { font-family: "DejaVu Sans", Arial, sans-serif; font-size: 10.5pt; color: #222; max-width: 190mm; margin: 1.5em auto; line-height: 1.35; }
+body.wide { max-width: 250mm; }
 h1 { font-size: 17pt; margin-bottom: 0.2em; } h2 { font-size: 13.5pt; border-bottom: 1px solid #999; margin-top: 1.6em; } h3 { font-size: 11.5pt; }
 table { border-collapse: collapse; margin: 0.8em 0; } caption { caption-side: bottom; text-align: left; font-size: 9pt; padding-top: 0.3em; }
 table.paper { border-top: 2px solid #222; border-bottom: 2px solid #222; } table.paper thead th { border-bottom: 1px solid #222; }
 th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child, th.l, td.l { text-align: left; }
+table.wide { font-size: 8.5pt; } table.wide th, table.wide td { padding: 0.15em 0.45em; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; } td.suspect { color: #a60; text-align: left; font-size: 9pt; } td.ok { color: #060; text-align: left; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
 pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; }
@@ -42,6 +44,7 @@ window.addEventListener('load', function () {
 pub struct Page {
     title: String,
     body: String,
+    wide: bool,
 }
 
 impl Page {
@@ -49,7 +52,12 @@ impl Page {
         Page {
             title: title.to_string(),
             body: format!("<h1>{}</h1>\n", escape(title)),
+            wide: false,
         }
+    }
+    /// A wider page (on screen) for tables of many columns.
+    pub fn widen(&mut self) {
+        self.wide = true;
     }
     pub fn h2(&mut self, s: &str) {
         self.body.push_str(&format!("<h2>{}</h2>\n", escape(s)));
@@ -94,8 +102,9 @@ impl Page {
     }
     pub fn finish(self) -> String {
         format!(
-            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{CSS}</style></head>\n<body>\n{}\n<p class=\"meta\">rocklab {} — Giresini &amp; Croce, COMPDYN 2021.</p>\n{CHECK}\n</body></html>\n",
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{CSS}</style></head>\n<body{}>\n{}\n<p class=\"meta\">rocklab {} — Giresini &amp; Croce, COMPDYN 2021.</p>\n{CHECK}\n</body></html>\n",
             escape(&self.title),
+            if self.wide { " class=\"wide\"" } else { "" },
             self.body,
             env!("CARGO_PKG_VERSION")
         )

@@ -161,7 +161,8 @@ fn md_cell(c: &Cell) -> String {
 pub fn to_html(t: &Table) -> String {
     use super::html::escape;
     let mut s = format!(
-        "<table class=\"paper\" id=\"{}\">\n<caption>{}</caption>\n<thead><tr>",
+        "<table class=\"paper{}\" id=\"{}\">\n<caption>{}</caption>\n<thead><tr>",
+        if t.nowrap { " wide" } else { "" },
         escape(&t.name),
         escape(&t.caption)
     );

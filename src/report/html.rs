@@ -22,7 +22,7 @@ th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-ch
 table.wide { font-size: 8.5pt; } table.wide th, table.wide td { padding: 0.15em 0.45em; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; } td.suspect { color: #a60; text-align: left; font-size: 9pt; } td.ok { color: #060; text-align: left; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
-pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; }
+pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; } .peaks td, .peaks th { padding: 0.15em 0.45em; }
 .warn { color: #8a5a00; }
 @page { size: A4; margin: 15mm; }
 @media print { body { max-width: none; margin: 0; } h2 { page-break-after: avoid; } }

@@ -79,12 +79,10 @@ fn mean_row(cols: Cols, label: &str, m: &Means, u: Option<&Means>) -> Vec<Cell> 
     for c in cols {
         let (v, ui) = ((c.2)(&q), qu.as_ref().map(|u| (c.2)(u)));
         cells.push(Cell {
+            u: ui,
             tex: Some(format!("{:.0}\\%", 100.0 * v)),
             ..Cell::num(v, percent_u(v, ui)).strong()
         });
-        if let Some(ui) = ui {
-            cells.last_mut().expect("just pushed").u = Some(ui);
-        }
     }
     cells.push(Cell {
         csv: Some("mean".into()),

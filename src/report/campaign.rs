@@ -112,8 +112,12 @@ fn test_plots(id: &str, r: &Reduced, e_h: f64) -> Result<(Figure, Figure), Repor
     let motion_fig = plots::render(&motion, 1000, 340)?;
     let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
+    let n = local.len();
     let ratios = [Panel {
         hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
+        // Impacts are counted: the axis names 1, 2, … (no ticks between them).
+        x_names: (1..=n).map(|k| k.to_string()).collect(),
+        x_range: Some((0.5, n as f64 + 0.5)),
         ..Panel::new(
             format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
             "impact",

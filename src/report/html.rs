@@ -22,7 +22,7 @@ th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-ch
 table.wide { font-size: 8.5pt; } table.wide th, table.wide td { padding: 0.15em 0.45em; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; } td.suspect { color: #a60; text-align: left; font-size: 9pt; } td.ok { color: #060; text-align: left; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
-pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; } .peaks td, .peaks th { padding: 0.15em 0.45em; }
+pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .meta td:first-child { overflow-wrap: normal; } .peaks td { white-space: nowrap; } .peaks td, .peaks th { padding: 0.15em 0.45em; }
 .warn { color: #8a5a00; }
 @page { size: A4; margin: 15mm; }
 @media print { body { max-width: none; margin: 0; } h2 { page-break-after: avoid; } }
@@ -78,22 +78,20 @@ impl Page {
         self.body
             .push_str(&format!("<figure>{svg}<figcaption>{}</figcaption></figure>\n", escape(caption)));
     }
-    /// A simple table from header and rows of text.
-    pub fn table(&mut self, class: &str, head: &[&str], rows: &[Vec<String>]) {
-        let mut s = format!("<table class=\"{class}\"><thead><tr>");
-        for h in head {
-            s.push_str(&format!("<th>{}</th>", escape(h)));
-        }
-        s.push_str("</tr></thead><tbody>\n");
+    /// A table of text (notes, provenance) in the one table model, class `class`
+    /// ("meta", plus "peaks" for the velocity peaks, whose columns after the first
+    /// are numbers and are right-aligned).
+    pub fn table(&mut self, class: &'static str, head: &[&str], rows: &[Vec<String>]) {
+        use super::table::{Align, Cell, Column};
+        let numbers = class.contains("peaks");
+        let align = |i: usize| if numbers && i > 0 { Align::Right } else { Align::Left };
+        let columns = head.iter().enumerate().map(|(i, h)| Column::new(h, h, align(i))).collect();
+        let mut t = Table::new("", String::new(), columns);
+        t.class = class;
         for r in rows {
-            s.push_str("<tr>");
-            for c in r {
-                s.push_str(&format!("<td>{}</td>", escape(c)));
-            }
-            s.push_str("</tr>\n");
+            t.push(None, r.iter().map(Cell::text).collect());
         }
-        s.push_str("</tbody></table>\n");
-        self.body.push_str(&s);
+        self.body.push_str(&to_html(&t));
     }
     /// The provenance table: every input with its path, size and SHA-256.
     pub fn provenance(&mut self, inputs: &[super::InputFile]) {
@@ -182,8 +180,8 @@ fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
                 notes.push(vec![
                     t.spec.id.clone(),
                     format!(
-                        "fit: p_e = {p:.4} rad/s, λ = {:?}, RMS {rms:.4} mm, noise {:.4} mm, spikes removed {}",
-                        r.analysis.lambda_fit.map(|l| format!("{l:.2}")),
+                        "fit: p_e = {p:.4} rad/s, λ = {}, RMS {rms:.4} mm, noise {:.4} mm, spikes removed {}",
+                        r.analysis.lambda_fit.map_or("—".to_string(), |l| format!("{l:.2} s⁻²")),
                         r.analysis.noise_mm,
                         r.analysis.spikes_removed
                     ),

@@ -109,6 +109,8 @@ pub struct Table {
     pub tex_note: Option<String>,
     /// Markdown and HTML cells stay on one line (the façade's ranges and times).
     pub nowrap: bool,
+    /// The HTML class: "paper" (the paper's rules) or "meta" (provenance, notes).
+    pub class: &'static str,
 }
 
 impl Table {
@@ -122,6 +124,7 @@ impl Table {
             csv,
             tex_note: None,
             nowrap: false,
+            class: "paper",
         }
     }
     pub fn push(&mut self, key: Option<String>, cells: Vec<Cell>) {
@@ -160,12 +163,17 @@ fn md_cell(c: &Cell) -> String {
 /// `data-value`, `data-u` on numeric cells.
 pub fn to_html(t: &Table) -> String {
     use super::html::escape;
-    let mut s = format!(
-        "<table class=\"paper{}\" id=\"{}\">\n<caption>{}</caption>\n<thead><tr>",
-        if t.nowrap { " wide" } else { "" },
-        escape(&t.name),
-        escape(&t.caption)
-    );
+    let wide = if t.nowrap { " wide" } else { "" };
+    let id = if t.name.is_empty() {
+        String::new()
+    } else {
+        format!(" id=\"{}\"", escape(&t.name))
+    };
+    let mut s = format!("<table class=\"{}{wide}\"{id}>\n", t.class);
+    if !t.caption.is_empty() {
+        s.push_str(&format!("<caption>{}</caption>\n", escape(&t.caption)));
+    }
+    s.push_str("<thead><tr>");
     for c in &t.columns {
         let class = if c.align == Align::Left { " class=\"l\"" } else { "" };
         s.push_str(&format!("<th{class} data-col=\"{}\">{}</th>", escape(&c.key), escape(&c.label)));

@@ -213,3 +213,47 @@ fn facade_results_table_markdown_and_html() {
     insta::assert_snapshot!("facade_results_md", to_markdown(&t));
     insta::assert_snapshot!("facade_results_html", to_html(&t));
 }
+
+/// The source files below `dir` (recursively), with their text.
+fn sources(dir: &Path) -> Vec<(std::path::PathBuf, String)> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            out.extend(sources(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push((p.clone(), std::fs::read_to_string(&p).unwrap()));
+        }
+    }
+    out
+}
+
+/// Issue #12: renderers return bytes and one function writes them; the report
+/// layer reads no file (the load step passes the inputs' facts in); the CLI holds
+/// no rendering code (no plot panels, no HTML, no Markdown table rows).
+#[test]
+fn only_write_files_writes_and_rendering_stays_in_report() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let writes: Vec<String> = sources(&src)
+        .iter()
+        .filter(|(p, _)| !p.ends_with("atomic.rs"))
+        .flat_map(|(p, text)| {
+            ["write_atomic(", "fs::write(", "File::create("]
+                .iter()
+                .filter(|w| text.lines().any(|l| l.contains(*w) && !l.trim_start().starts_with("//")))
+                .map(move |w| format!("{} calls {w}", p.display()))
+        })
+        .collect();
+    assert_eq!(writes.len(), 1, "one writer (report::write_files) expected: {writes:?}");
+    assert!(writes[0].contains("report/mod.rs"), "{writes:?}");
+    for (p, text) in sources(&src.join("report")) {
+        for read in ["fs::read", "File::open"] {
+            assert!(!text.contains(read), "{} reads a file ({read})", p.display());
+        }
+    }
+    for (p, text) in sources(&src.join("cli")) {
+        for render in ["Panel", "plots::", "<table", "<td", "\"| "] {
+            assert!(!text.contains(render), "{} renders ({render}): move it to src/report", p.display());
+        }
+    }
+}

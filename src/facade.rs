@@ -112,6 +112,8 @@ pub struct StudyRecord {
 pub struct Study {
     pub name: String,
     pub path: PathBuf,
+    /// The block file as the study named it, resolved against the study's folder.
+    pub block_path: PathBuf,
     pub block: BlockSpec,
     pub magnification: f64,
     pub polarities: Vec<f64>,
@@ -506,6 +508,7 @@ impl Study {
             ida_samples: h.ida_samples.unwrap_or(if any_random { 10 } else { 1 }).max(1),
             name: h.name.clone().unwrap_or_else(|| block.name.clone()),
             path: path.to_path_buf(),
+            block_path: base.join(&raw.study.block),
             magnification: h.magnification,
             polarities,
             overturn_limit,

@@ -18,6 +18,7 @@ pub mod fit;
 pub mod fragility;
 pub mod ground_motion;
 pub mod ingest;
+pub mod outcomes;
 pub mod peaks;
 pub mod reduce;
 pub mod report;

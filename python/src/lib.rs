@@ -116,7 +116,7 @@ fn reduce_doc(res: &CampaignResult, with_series: bool) -> anyhow::Result<(Value,
             }
         }
     }
-    Ok((json!({"summary": summary(res), "tables": tabs}), series))
+    Ok((json!({"summary": summary(res)?, "tables": tabs}), series))
 }
 
 /// `rocklab reduce MANIFEST` without writing files.
@@ -311,7 +311,7 @@ fn simulate<'py>(
             keep_history: history,
         };
         let (summary, sim) = run(&block, &record, &spec);
-        let doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim);
+        let doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
         let alpha = block.block.alpha;
         let h = &sim.history;
         let series: Series = vec![
@@ -338,7 +338,7 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
         let cal = rocklab::calibrate::calibrate(&res, impacts);
         let wall = start.elapsed().as_secs_f64();
         let (mut doc, _) = reduce_doc(&res, false)?;
-        doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall);
+        doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall)?;
         doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal));
         Ok(doc)
     })?;
@@ -356,7 +356,7 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
         let runs = run_study(&study, 1.0, false, &|| {});
         let wall = start.elapsed().as_secs_f64();
         let ida = scales.map(|sc| run_ida(&study, &sc, &|| {}));
-        Ok(json!({"summary": docs::facade_summary(&study, &runs, wall), "ida": ida}))
+        Ok(json!({"summary": docs::facade_summary(&study, &runs, wall, None, None)?, "ida": ida}))
     })?;
     Ok(doc.to_string())
 }

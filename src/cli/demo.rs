@@ -13,10 +13,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     for name in ["one-sided-demo", "two-sided-demo"] {
         let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
         let campaign = Campaign::load(&manifest)?;
+        let sources = super::load::campaign_sources(&campaign);
         let res = reduce_and_print(campaign, PeakOptions::default());
         ok &= res.failed().next().is_none();
-        // Writes everything `reduce` writes, then the calibration on top.
-        let cal = super::calibrate::calibrate_and_write(&res, &args.out.join(name), 6)?;
+        // Writes everything `reduce` writes, with the calibration on top.
+        let cal = super::calibrate::calibrate_and_write(&res, &sources, &args.out.join(name), 6)?;
         ok &= cal.failed.is_empty();
         say("");
     }
@@ -37,10 +38,6 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         scales.len(),
         study.ida_samples
     ));
-    let out = args.out.join("facade");
-    std::fs::create_dir_all(&out)?;
-    let rep = super::facade::run_all(&study, Some(&scales), &out)?;
-    super::facade::write_report(&study, &rep, &out)?;
-    say(&format!("wrote {}", out.display()));
+    super::facade::run_and_write(&study, Some(&scales), &args.out.join("facade"))?;
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

@@ -9,6 +9,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod calibrate;
 mod demo;
 mod facade;
+mod load;
 mod reduce;
 mod simulate;
 

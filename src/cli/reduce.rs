@@ -1,14 +1,15 @@
-//! `rocklab reduce MANIFEST --out DIR`.
+//! `rocklab reduce MANIFEST --out DIR`: load the campaign, reduce it, write the
+//! report.
 
 use std::process::ExitCode;
 
 use anyhow::Context;
 
-use super::{say, EstimatorArgs, MethodArg, ReduceArgs};
+use super::{load, say, EstimatorArgs, MethodArg, ReduceArgs};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::{Method, PeakOptions};
 use rocklab::reduce::{reduce_campaign_with, CampaignResult};
-use rocklab::report;
+use rocklab::report::{self, tables};
 use rocklab::signal::savgol::SavGol;
 
 pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
@@ -22,9 +23,10 @@ pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
 pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {
     let opts = options(&args.estimator)?;
     let campaign = Campaign::load(&args.manifest)?;
+    let sources = load::campaign_sources(&campaign);
     let res = reduce_and_print(campaign, opts);
-    report::write_reduce_outputs(&res, &args.out, !args.estimator.no_plots, &report::Extras::default())
-        .with_context(|| format!("writing {}", args.out.display()))?;
+    let files = report::reduce_files(&res, &sources, !args.estimator.no_plots, &report::Extras::default())?;
+    report::write_files(&args.out, &files).with_context(|| format!("writing {}", args.out.display()))?;
     say(&format!("wrote {}", args.out.display()));
     Ok(exit_code(&res))
 }
@@ -51,8 +53,7 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
             eprintln!("warning: test {}: {w}", t.spec.id);
         }
     }
-    let tables = report::tables::tables(&res);
-    say(&report::tables::to_markdown(&tables[0]));
+    say(&tables::to_markdown(&tables::tables(&res)[0]));
     if !res.means.left_out.is_empty() {
         say(&format!("means leave out: {}", res.means.left_out_text()));
     }

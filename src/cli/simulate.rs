@@ -7,10 +7,9 @@ use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 
 use super::say;
-use rocklab::atomic::write_atomic;
 use rocklab::ground_motion::{self, Format, ReadOptions, Units};
 use rocklab::ingest::block::BlockSpec;
-use rocklab::report::plots::{self, Panel, Series};
+use rocklab::report::{docs, response, write_files, Files};
 use rocklab::study::{run, RunSpec};
 
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,12 +109,11 @@ fn coefficients_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result
     })
 }
 
-pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
-    let block = BlockSpec::load(&a.block)?;
-    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+/// The run's settings from the arguments and the block file's defaults, validated.
+fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec> {
     let (e_in, e_out) = match &a.calibration {
         Some(file) => rocklab::facade::read_calibration(file)?,
-        None => coefficients_from_args(&a, &block)?,
+        None => coefficients_from_args(a, block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
     if a.polarity != 1 && a.polarity != -1 {
@@ -124,36 +122,31 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     if !(a.scale.is_finite() && a.scale > 0.0) {
         bail!("--scale {}: expected a positive number", a.scale);
     }
-    let limit = a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha);
-    let spec = RunSpec {
+    Ok(RunSpec {
         e_in,
         e_out,
         scale: a.scale,
         polarity: a.polarity as f64,
-        overturn_limit: limit,
+        overturn_limit: a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha),
         t_extra: a.t_extra,
         rtol: a.rtol,
         atol: a.atol,
         keep_history: true,
-    };
+    })
+}
+
+pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
+    let block = BlockSpec::load(&a.block)?;
+    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let spec = spec_from_args(&a, &block)?;
     let (summary, sim) = run(&block, &record, &spec);
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let alpha = block.block.alpha;
-    let doc = rocklab::report::docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim);
-    write_atomic(&a.out.join("summary.json"), &serde_json::to_vec_pretty(&doc)?)?;
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["t_s", "theta_rad", "theta_over_alpha", "theta_dot_rad_s", "ag_m_s2"])?;
-    for s in &sim.history {
-        w.write_record([s.t, s.theta, s.theta / alpha, s.omega, s.ag].iter().map(|v| v.to_string()))?;
-    }
-    write_atomic(&a.out.join("history.csv"), &w.into_inner()?)?;
-    let panels = response_panels(
-        &block.name,
-        &[("response", &sim.history, plots::RED)],
-        alpha,
-        &record_points(&record, &spec),
-    );
-    plots::render(&a.out.join("response"), &panels, 1000, 320)?;
+    let mut files = Files::default();
+    let doc = docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim)?;
+    files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
+    files.add("history.csv", response::history_csv(&sim.history, alpha)?);
+    response::simulate_figure(&block.name, &sim.history, alpha, &record, &spec)?.add_to(&mut files, "response");
+    write_files(&a.out, &files).with_context(|| format!("writing {}", a.out.display()))?;
     say(&format!(
         "{}: max θ/α = {:.3}, min θ/α = {:.3}, {}, {} impacts, PGA {:.3} g, PGV {:.2} cm/s, solved in {:.2} ms",
         block.name,
@@ -170,53 +163,4 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     ));
     say(&format!("wrote {}", a.out.display()));
     Ok(ExitCode::SUCCESS)
-}
-
-/// The scaled ground acceleration in g for plots.
-pub fn record_points(record: &ground_motion::Record, spec: &RunSpec) -> Vec<(f64, f64)> {
-    let k = spec.scale * spec.polarity / rocklab::G;
-    record
-        .acc_m_s2
-        .iter()
-        .enumerate()
-        .map(|(i, a)| (record.t0 + i as f64 * record.dt, a * k))
-        .collect()
-}
-
-/// Paper Fig. 8/9 style: θ/α of one or more runs over time, then the scaled ground
-/// acceleration.
-pub fn response_panels(title: &str, runs: &[(&str, &[rocklab::solver::run::Sample], plots::RGBColor)], alpha: f64, ag: &[(f64, f64)]) -> Vec<Panel> {
-    let span = ag.first().zip(ag.last()).map(|(a, b)| (a.0, b.0));
-    let series = runs
-        .iter()
-        .map(|(label, h, color)| Series {
-            label: label.to_string(),
-            color: *color,
-            points: h.iter().map(|s| (s.t, s.theta / alpha)).collect(),
-            markers: false,
-        })
-        .collect();
-    vec![
-        Panel {
-            title: format!("{title}: normalised rotation"),
-            x_label: "time (s)".into(),
-            y_label: "θ/α".into(),
-            series,
-            hline: None,
-            x_range: span,
-        },
-        Panel {
-            title: "ground acceleration (scaled)".into(),
-            x_label: "time (s)".into(),
-            y_label: "ü_g (g)".into(),
-            series: vec![Series {
-                label: "ü_g".into(),
-                color: plots::BLACKISH,
-                points: ag.to_vec(),
-                markers: false,
-            }],
-            hline: None,
-            x_range: span,
-        },
-    ]
 }

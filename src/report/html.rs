@@ -3,10 +3,7 @@
 //! (manifest, input files with size and SHA-256, e_H and its source, the
 //! differentiation method, the tool's version, every warning). Prints on A4.
 
-use std::path::Path;
-
-use sha2::{Digest, Sha256};
-
+use super::campaign::{Sources, TestFigures};
 use super::tables::{to_html, Table};
 use crate::reduce::CampaignResult;
 
@@ -17,13 +14,15 @@ pub fn escape(s: &str) -> String {
 
 const CSS: &str = r#"
 body { font-family: "DejaVu Sans", Arial, sans-serif; font-size: 10.5pt; color: #222; max-width: 190mm; margin: 1.5em auto; line-height: 1.35; }
+body.wide { max-width: 250mm; }
 h1 { font-size: 17pt; margin-bottom: 0.2em; } h2 { font-size: 13.5pt; border-bottom: 1px solid #999; margin-top: 1.6em; } h3 { font-size: 11.5pt; }
 table { border-collapse: collapse; margin: 0.8em 0; } caption { caption-side: bottom; text-align: left; font-size: 9pt; padding-top: 0.3em; }
 table.paper { border-top: 2px solid #222; border-bottom: 2px solid #222; } table.paper thead th { border-bottom: 1px solid #222; }
-th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child { text-align: left; }
+th, td { padding: 0.15em 0.8em; text-align: right; } th:first-child, td:first-child, th.l, td.l { text-align: left; }
+table.wide { font-size: 8.5pt; } table.wide th, table.wide td { padding: 0.15em 0.45em; }
 tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: #a00; text-align: left; font-size: 9pt; } td.suspect { color: #a60; text-align: left; font-size: 9pt; } td.ok { color: #060; text-align: left; }
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
-pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .peaks td { white-space: nowrap; }
+pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .meta td:first-child { overflow-wrap: normal; } .peaks td { white-space: nowrap; } .peaks td, .peaks th { padding: 0.15em 0.45em; }
 .warn { color: #8a5a00; }
 @page { size: A4; margin: 15mm; }
 @media print { body { max-width: none; margin: 0; } h2 { page-break-after: avoid; } }
@@ -45,6 +44,7 @@ window.addEventListener('load', function () {
 pub struct Page {
     title: String,
     body: String,
+    wide: bool,
 }
 
 impl Page {
@@ -52,7 +52,12 @@ impl Page {
         Page {
             title: title.to_string(),
             body: format!("<h1>{}</h1>\n", escape(title)),
+            wide: false,
         }
+    }
+    /// A wider page (on screen) for tables of many columns.
+    pub fn widen(&mut self) {
+        self.wide = true;
     }
     pub fn h2(&mut self, s: &str) {
         self.body.push_str(&format!("<h2>{}</h2>\n", escape(s)));
@@ -73,46 +78,39 @@ impl Page {
         self.body
             .push_str(&format!("<figure>{svg}<figcaption>{}</figcaption></figure>\n", escape(caption)));
     }
-    /// A simple table from header and rows of text.
-    pub fn table(&mut self, class: &str, head: &[&str], rows: &[Vec<String>]) {
-        let mut s = format!("<table class=\"{class}\"><thead><tr>");
-        for h in head {
-            s.push_str(&format!("<th>{}</th>", escape(h)));
-        }
-        s.push_str("</tr></thead><tbody>\n");
+    /// A table of text (notes, provenance) in the one table model, class `class`
+    /// ("meta", plus "peaks" for the velocity peaks, whose columns after the first
+    /// are numbers and are right-aligned).
+    pub fn table(&mut self, class: &'static str, head: &[&str], rows: &[Vec<String>]) {
+        use super::table::{Align, Cell, Column};
+        let numbers = class.contains("peaks");
+        let align = |i: usize| if numbers && i > 0 { Align::Right } else { Align::Left };
+        let columns = head.iter().enumerate().map(|(i, h)| Column::new(h, h, align(i))).collect();
+        let mut t = Table::new("", String::new(), columns);
+        t.class = class;
         for r in rows {
-            s.push_str("<tr>");
-            for c in r {
-                s.push_str(&format!("<td>{}</td>", escape(c)));
-            }
-            s.push_str("</tr>\n");
+            t.push(None, r.iter().map(Cell::text).collect());
         }
-        s.push_str("</tbody></table>\n");
-        self.body.push_str(&s);
+        self.body.push_str(&to_html(&t));
+    }
+    /// The provenance table: every input with its path, size and SHA-256.
+    pub fn provenance(&mut self, inputs: &[super::InputFile]) {
+        let rows: Vec<Vec<String>> = inputs.iter().map(|f| f.row()).collect();
+        self.table("meta", &["input", "file", "size", "SHA-256"], &rows);
     }
     pub fn finish(self) -> String {
         format!(
-            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{CSS}</style></head>\n<body>\n{}\n<p class=\"meta\">rocklab {} — Giresini &amp; Croce, COMPDYN 2021.</p>\n{CHECK}\n</body></html>\n",
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{CSS}</style></head>\n<body{}>\n{}\n<p class=\"meta\">rocklab {} — Giresini &amp; Croce, COMPDYN 2021.</p>\n{CHECK}\n</body></html>\n",
             escape(&self.title),
+            if self.wide { " class=\"wide\"" } else { "" },
             self.body,
             env!("CARGO_PKG_VERSION")
         )
     }
 }
 
-/// Size and SHA-256 of a file (hex), or the error.
-pub fn file_facts(path: &Path) -> (String, String) {
-    match std::fs::read(path) {
-        Ok(b) => (
-            format!("{} bytes", b.len()),
-            Sha256::digest(&b).iter().map(|x| format!("{x:02x}")).collect(),
-        ),
-        Err(e) => ("—".into(), format!("unreadable: {e}")),
-    }
-}
-
 /// The reduce report (plus extra sections, e.g. the calibration).
-pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String, String)], extra: &[String]) -> String {
+pub fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: &[String], sources: &Sources) -> String {
     let c = &res.campaign;
     let mut page = Page::new(&format!("{} — coefficients of restitution ({} rocking)", c.name, c.rocking.as_str()));
     page.p(&format!(
@@ -155,22 +153,23 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
         page.raw(x);
     }
     page.h2("Plots");
-    for (id, motion, ratios) in svgs {
+    for (id, motion, ratios) in figs {
         page.h3(&format!("Test {id}"));
         page.figure(
-            motion,
+            &motion.svg,
             &format!("Test {id}: displacement and velocity with the velocity peaks marked (paper Fig. 3/4)."),
         );
-        page.figure(ratios, &format!("Test {id}: local ratios of Eq. 3 and their mean (paper Fig. 5)."));
+        page.figure(&ratios.svg, &format!("Test {id}: local ratios of Eq. 3 and their mean (paper Fig. 5)."));
     }
+    provenance(&mut page, res, sources);
+    page.finish()
+}
+
+/// The provenance section of the reduce report: the inputs with their checksums,
+/// what reading and fitting each log noted, every warning, the tool, the manifest.
+fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
     page.h2("Provenance");
-    let (size, sha) = file_facts(&c.manifest_path);
-    let mut files = vec![vec!["manifest".to_string(), c.manifest_path.display().to_string(), size, sha]];
-    for t in &res.tests {
-        let (size, sha) = file_facts(&t.spec.file);
-        files.push(vec![t.spec.id.clone(), t.spec.file.display().to_string(), size, sha]);
-    }
-    page.table("meta", &["input", "file", "size", "SHA-256"], &files);
+    page.provenance(&sources.files);
     let mut notes = Vec::new();
     for t in &res.tests {
         if let Ok(r) = &t.result {
@@ -181,8 +180,8 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
                 notes.push(vec![
                     t.spec.id.clone(),
                     format!(
-                        "fit: p_e = {p:.4} rad/s, λ = {:?}, RMS {rms:.4} mm, noise {:.4} mm, spikes removed {}",
-                        r.analysis.lambda_fit.map(|l| format!("{l:.2}")),
+                        "fit: p_e = {p:.4} rad/s, λ = {}, RMS {rms:.4} mm, noise {:.4} mm, spikes removed {}",
+                        r.analysis.lambda_fit.map_or("—".to_string(), |l| format!("{l:.2} s⁻²")),
                         r.analysis.noise_mm,
                         r.analysis.spikes_removed
                     ),
@@ -208,6 +207,5 @@ pub fn reduce_page(res: &CampaignResult, tabs: &[Table], svgs: &[(String, String
         res.options.method.describe()
     ));
     page.h3("Manifest");
-    page.pre(&std::fs::read_to_string(&c.manifest_path).unwrap_or_default());
-    page.finish()
+    page.pre(&sources.manifest);
 }

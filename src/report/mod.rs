@@ -1,156 +1,101 @@
-//! The output edge: the `summary.json` contract, the tables as CSV and Markdown,
-//! and the plots. Renderers return bytes; [`crate::atomic::write_atomic`] writes.
+//! The output edge: the `summary.json` contract, the tables (one model, four
+//! formats), the plots and the HTML pages. Every renderer returns bytes into a
+//! [`Files`]; [`write_files`] is the one function that writes them (atomically).
+//! The inputs a page names in its provenance arrive as [`InputFile`]s, read and
+//! hashed by the load step; nothing here reads a file.
 
+pub mod calibration;
+pub mod campaign;
 pub mod docs;
+pub mod facade;
 pub mod html;
 pub mod plots;
+pub mod response;
 pub mod summary;
+pub mod table;
 pub mod tables;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
-use rayon::prelude::*;
+pub use campaign::{reduce_files, Extras};
 
-use crate::atomic::write_atomic;
-use crate::reduce::{CampaignResult, Reduced};
-use crate::restitution::local_ratios;
-use plots::{Panel, Series};
-
-/// SVG texts of the plots of one test: (id, motion, ratios).
-pub type TestSvgs = Vec<(String, String, String)>;
-
-/// What a later step (the calibration) adds to the reduce outputs: keys of
-/// summary.json and sections of report.html.
-#[derive(Debug, Default)]
-pub struct Extras {
-    pub summary: serde_json::Map<String, serde_json::Value>,
-    pub html_sections: Vec<String>,
+/// What can go wrong while rendering or writing the outputs.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    #[error("plot: {0}")]
+    Plot(String),
+    #[error("CSV: {0}")]
+    Csv(#[from] csv::Error),
+    #[error("JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    #[error("writing {path}: {source}")]
+    Write { path: PathBuf, source: std::io::Error },
 }
 
-/// Write everything `reduce` produces into `out`: summary.json, tables (CSV,
-/// Markdown, LaTeX), per-test plots (PNG and SVG) unless `with_plots` is false, and
-/// the self-contained report.html, with what `extra` adds.
-pub fn write_reduce_outputs(res: &CampaignResult, out: &Path, with_plots: bool, extra: &Extras) -> Result<()> {
-    std::fs::create_dir_all(out)?;
-    let mut doc = summary::summary(res);
-    if let Some(map) = doc.as_object_mut() {
-        map.extend(extra.summary.clone());
+/// Files to write, by path relative to the output folder, in order.
+#[derive(Debug, Default)]
+pub struct Files(Vec<(PathBuf, Vec<u8>)>);
+
+impl Files {
+    pub fn add(&mut self, path: impl Into<PathBuf>, bytes: impl Into<Vec<u8>>) {
+        self.0.push((path.into(), bytes.into()));
     }
-    let json = serde_json::to_vec_pretty(&doc)?;
-    write_atomic(&out.join("summary.json"), &json)?;
-    let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
-    let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
-    let tabs = tables::tables(res);
-    for t in &tabs {
-        write_atomic(&out.join(format!("{}.csv", t.name)), &tables::to_csv(t)?)?;
-        let one = tables::to_markdown(t);
-        write_atomic(&out.join(format!("{}.md", t.name)), one.as_bytes())?;
-        md.push_str(&one);
-        md.push('\n');
-        tex.push_str(&tables::to_latex(t));
-        tex.push('\n');
+    pub fn append(&mut self, other: Files) {
+        self.0.extend(other.0);
     }
-    md.push_str(&format!("Velocity peaks: {}.\n", res.options.method.describe()));
-    write_atomic(&out.join("tables.md"), md.as_bytes())?;
-    write_atomic(&out.join("tables.tex"), tex.as_bytes())?;
-    let mut svgs: TestSvgs = Vec::new();
-    if with_plots {
-        let dir = out.join("plots");
-        std::fs::create_dir_all(&dir)?;
-        svgs = res
-            .tests
-            .par_iter()
-            .filter_map(|t| t.result.as_ref().ok().map(|r| (t.spec.id.as_str(), r)))
-            .map(|(id, r)| test_plots(&dir, id, r, res.campaign.e_housner).map(|(m, q)| (id.to_string(), m, q)))
-            .collect::<Result<Vec<_>>>()?;
+    /// The bytes of `path`, if a renderer produced it.
+    pub fn get(&self, path: &str) -> Option<&[u8]> {
+        self.0.iter().find(|(p, _)| p == Path::new(path)).map(|(_, b)| b.as_slice())
     }
-    let page = html::reduce_page(res, &tabs, &svgs, &extra.html_sections);
-    write_atomic(&out.join("report.html"), page.as_bytes())?;
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.0.iter().map(|(p, _)| p.as_path())
+    }
+}
+
+/// The one writer: every file under `dir` (folders created), each atomically
+/// ([`crate::atomic::write_atomic`]: a temporary sibling, then a rename).
+pub fn write_files(dir: &Path, files: &Files) -> Result<(), ReportError> {
+    for (rel, bytes) in &files.0 {
+        let path = dir.join(rel);
+        crate::atomic::write_atomic(&path, bytes).map_err(|source| ReportError::Write { path, source })?;
+    }
     Ok(())
 }
 
-/// Paper Fig. 3/4 (displacement and velocity with the peaks) and Fig. 5 (local
-/// ratios with their mean) for one test.
-fn test_plots(dir: &Path, id: &str, r: &Reduced, e_h: f64) -> Result<(String, String)> {
-    let a = &r.analysis;
-    let t = &r.log.time_s;
-    let last = a.impacts.last().map_or(a.release_time_s + 1.0, |i| i.time_s);
-    let span = last - a.release_time_s;
-    let (t0, t1) = (a.release_time_s - 0.15 * span, last + 0.25 * span);
-    let window = |i: &usize| t[*i] >= t0 && t[*i] <= t1;
-    let idx: Vec<usize> = (0..t.len()).filter(window).collect();
-    let measured: Vec<(f64, f64)> = idx.iter().map(|&i| (t[i], a.displacement_mm[i])).collect();
-    let velocity: Vec<(f64, f64)> = idx.iter().map(|&i| (t[i], a.velocity_mm_s[i])).collect();
-    let fit_x: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.1)).collect();
-    let fit_v: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.2)).collect();
-    let peaks: Vec<(f64, f64)> = a.peaks.iter().map(|p| (p.time_s, p.velocity_mm_s)).collect();
-    let mut disp = vec![Series {
-        label: "measured (zero: final rest line)".into(),
-        color: plots::GREY,
-        points: measured,
-        markers: false,
-    }];
-    let mut vel = vec![Series {
-        label: "velocity (per sample)".into(),
-        color: plots::GREY,
-        points: velocity,
-        markers: false,
-    }];
-    if !fit_x.is_empty() {
-        disp.push(Series {
-            label: "free-rocking fit".into(),
-            color: plots::RED,
-            points: fit_x,
-            markers: false,
-        });
-        vel.push(Series {
-            label: "fit, one-sided at impacts".into(),
-            color: plots::BLUE,
-            points: fit_v,
-            markers: false,
-        });
+/// The bytes of a finished CSV writer.
+pub(crate) fn csv_bytes(w: csv::Writer<Vec<u8>>) -> Result<Vec<u8>, ReportError> {
+    w.into_inner().map_err(|e| ReportError::Csv(e.into_error().into()))
+}
+
+/// An input file as the load step found it, for a page's provenance: its role
+/// ("manifest", a test id, "study"…), its path, and its size and SHA-256 (hex)
+/// or why it could not be read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputFile {
+    pub role: String,
+    pub path: PathBuf,
+    pub facts: Result<(usize, String), String>,
+}
+
+impl InputFile {
+    /// Describe `path` from what reading it gave.
+    pub fn new(role: &str, path: &Path, read: std::io::Result<Vec<u8>>) -> InputFile {
+        use sha2::{Digest, Sha256};
+        let facts = read
+            .map(|b| (b.len(), Sha256::digest(&b).iter().map(|x| format!("{x:02x}")).collect()))
+            .map_err(|e| format!("unreadable: {e}"));
+        InputFile {
+            role: role.into(),
+            path: path.to_path_buf(),
+            facts,
+        }
     }
-    vel.push(Series {
-        label: "peaks v_k".into(),
-        color: plots::RED,
-        points: peaks,
-        markers: true,
-    });
-    let motion = [
-        Panel {
-            title: format!("Test {id}: displacement at the sensor (outward +)"),
-            x_label: "time (s)".into(),
-            y_label: "displacement (mm)".into(),
-            series: disp,
-            hline: None,
-            x_range: None,
-        },
-        Panel {
-            title: format!("Test {id}: velocity and its peaks"),
-            x_label: "time (s)".into(),
-            y_label: "velocity (mm/s)".into(),
-            series: vel,
-            hline: None,
-            x_range: None,
-        },
-    ];
-    let motion_svg = plots::render(&dir.join(format!("{id}_motion")), &motion, 1000, 340)?;
-    let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
-    let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
-    let ratios = [Panel {
-        title: format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
-        x_label: "impact".into(),
-        y_label: "ratio".into(),
-        series: vec![Series {
-            label: "local ratio".into(),
-            color: plots::RED,
-            points: local,
-            markers: true,
-        }],
-        hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
-        x_range: None,
-    }];
-    let ratios_svg = plots::render(&dir.join(format!("{id}_ratios")), &ratios, 800, 400)?;
-    Ok((motion_svg, ratios_svg))
+    /// The provenance row: role, path, size, SHA-256.
+    pub fn row(&self) -> Vec<String> {
+        let (size, sha) = match &self.facts {
+            Ok((n, sha)) => (format!("{n} bytes"), sha.clone()),
+            Err(e) => ("—".into(), e.clone()),
+        };
+        vec![self.role.clone(), self.path.display().to_string(), size, sha]
+    }
 }

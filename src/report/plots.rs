@@ -1,16 +1,17 @@
 //! Plots in PNG and SVG (plotters). Text is drawn with the DejaVu Sans font shipped
 //! in `fixtures/fonts` through plotters' `ab_glyph` backend, so no system font
-//! library is needed. Every file is written atomically.
+//! library is needed. Rendering returns bytes ([`Figure`]); [`super::write_files`]
+//! writes them.
 
-use std::path::Path;
 use std::sync::Once;
 
-use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 pub use plotters::style::RGBColor;
 
-use crate::atomic::write_atomic;
+use super::{Files, ReportError};
+
+type Result<T> = std::result::Result<T, ReportError>;
 
 static FONT: &[u8] = include_bytes!("../../fixtures/fonts/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
@@ -24,8 +25,8 @@ pub fn register_font() {
     });
 }
 
-fn err<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("plot: {e:?}")
+fn err<E: std::fmt::Debug>(e: E) -> ReportError {
+    ReportError::Plot(format!("{e:?}"))
 }
 
 /// A line series: label, colour, points.
@@ -37,7 +38,27 @@ pub struct Series {
     pub markers: bool,
 }
 
+impl Series {
+    /// A line through `points`.
+    pub fn line(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            points,
+            markers: false,
+        }
+    }
+    /// A marker at each of `points`.
+    pub fn dots(label: &str, color: RGBColor, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            markers: true,
+            ..Series::line(label, color, points)
+        }
+    }
+}
+
 /// One panel: title, axis labels, series, optional horizontal line (value, label).
+#[derive(Default)]
 pub struct Panel {
     pub title: String,
     pub x_label: String,
@@ -46,6 +67,33 @@ pub struct Panel {
     pub hline: Option<(f64, String)>,
     /// Fixed x range (otherwise from the data).
     pub x_range: Option<(f64, f64)>,
+    /// Fixed y range (otherwise from the data), e.g. to leave the legend room.
+    pub y_range: Option<(f64, f64)>,
+    /// Names of the categories at x = 1, 2, … (the x axis shows them instead of numbers).
+    pub x_names: Vec<String>,
+}
+
+impl Panel {
+    /// A panel of `series` with its title and axis labels (ranges from the data).
+    pub fn new(title: impl Into<String>, x_label: &str, y_label: &str, series: Vec<Series>) -> Panel {
+        Panel {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            series,
+            ..Panel::default()
+        }
+    }
+}
+
+/// The x-axis label at `x`: the name of the category at that integer, else nothing.
+fn category(names: &[String], x: f64) -> String {
+    let i = x.round();
+    if (x - i).abs() < 1e-6 && i >= 1.0 && i as usize <= names.len() {
+        names[i as usize - 1].clone()
+    } else {
+        String::new()
+    }
 }
 
 fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
@@ -77,10 +125,8 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) 
 where
     DB::ErrorType: 'static,
 {
-    let ((mut x0, mut x1), (y0, y1)) = bounds(panel);
-    if let Some((a, b)) = panel.x_range {
-        (x0, x1) = (a, b);
-    }
+    let (x, y) = bounds(panel);
+    let ((x0, x1), (y0, y1)) = (panel.x_range.unwrap_or(x), panel.y_range.unwrap_or(y));
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 18))
         .margin(8)
@@ -88,14 +134,16 @@ where
         .y_label_area_size(64)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc(panel.x_label.as_str())
+    let names = |x: &f64| category(&panel.x_names, *x);
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(panel.x_label.as_str())
         .y_desc(panel.y_label.as_str())
         .label_style(("sans-serif", 13))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(err)?;
+        .light_line_style(RGBColor(235, 235, 235));
+    if !panel.x_names.is_empty() {
+        mesh.x_labels(panel.x_names.len() + 1).x_label_formatter(&names);
+    }
+    mesh.draw().map_err(err)?;
     for s in &panel.series {
         let color = s.color;
         if s.markers {
@@ -151,19 +199,39 @@ where
     Ok(())
 }
 
-/// Render stacked panels to `stem.png` and `stem.svg` (atomically); returns the
-/// SVG text (for inlining in HTML reports).
-pub fn render(stem: &Path, panels: &[Panel], width: u32, height_per_panel: u32) -> Result<String> {
+/// A rendered figure: the SVG text (inlined in the HTML reports) and the PNG bytes.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    pub svg: String,
+    pub png: Vec<u8>,
+}
+
+impl Figure {
+    /// Add `stem.svg` and `stem.png` to the files to write.
+    pub fn add_to(&self, files: &mut Files, stem: &str) {
+        files.add(format!("{stem}.svg"), self.svg.as_bytes());
+        files.add(format!("{stem}.png"), self.png.clone());
+    }
+}
+
+/// A figure with its caption and the file stem it is written under.
+pub struct Captioned {
+    pub stem: String,
+    pub caption: String,
+    pub figure: Figure,
+}
+
+/// Render stacked panels as SVG and PNG, `width` wide and `height_per_panel`
+/// high per panel.
+pub fn render(panels: &[Panel], width: u32, height_per_panel: u32) -> Result<Figure> {
     register_font();
     let size = (width, height_per_panel * panels.len() as u32);
     let mut svg = String::new();
     draw_figure(SVGBackend::with_string(&mut svg, size).into_drawing_area(), panels)?;
-    write_atomic(&stem.with_extension("svg"), svg.as_bytes())?;
     let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
     draw_figure(BitMapBackend::with_buffer(&mut buf, size).into_drawing_area(), panels)?;
     let png = encode_png(&buf, size.0, size.1)?;
-    write_atomic(&stem.with_extension("png"), &png)?;
-    Ok(svg)
+    Ok(Figure { svg, png })
 }
 
 /// Encode an RGB buffer as PNG (through the `image` crate that plotters' bitmap

@@ -1,82 +1,127 @@
-//! `summary.json` of `rocklab reduce`, exactly as SPEC defines it.
+//! `summary.json` of `rocklab reduce`, exactly as SPEC defines it, derived from
+//! the `Serialize` types of the core (coefficients, peaks, impacts, means).
 
-use serde_json::{json, Map, Value};
+use serde::ser::{Serialize, SerializeMap, Serializer};
+use serde_json::Value;
 
-use crate::reduce::CampaignResult;
+use crate::peaks::{Impact, Peak};
+use crate::reduce::{CampaignResult, TestOutcome};
+use crate::restitution::Coefficients;
+use crate::tables::Means;
 
-/// Build the summary document (SPEC "the output contract").
-pub fn summary(res: &CampaignResult) -> Value {
+/// The standard uncertainties of a test's coefficients, each key with `_u`
+/// appended (`r_plus_u` beside `r_plus`).
+struct Uncertainties<'a>(&'a Coefficients);
+
+impl Serialize for Uncertainties<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let Value::Object(fields) = serde_json::to_value(self.0).map_err(serde::ser::Error::custom)? else {
+            return Err(serde::ser::Error::custom("coefficients are not a map"));
+        };
+        let mut m = s.serialize_map(Some(fields.len()))?;
+        for (k, v) in &fields {
+            m.serialize_entry(&format!("{k}_u"), v)?;
+        }
+        m.end()
+    }
+}
+
+/// What a reduced test adds to its entry.
+#[derive(serde::Serialize)]
+struct Reduction<'a> {
+    peaks: &'a [Peak],
+    contact_phases: bool,
+    #[serde(flatten)]
+    coefficients: &'a Coefficients,
+    #[serde(flatten)]
+    u: Option<Uncertainties<'a>>,
+    release_time_s: f64,
+    impacts: &'a [Impact],
+}
+
+/// One entry of `"tests"`.
+#[derive(serde::Serialize)]
+struct TestDoc<'a> {
+    id: &'a str,
+    status: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<&'a str>,
+    #[serde(flatten)]
+    reduction: Option<Reduction<'a>>,
+    exclude_from_mean: bool,
+    #[serde(skip_serializing_if = "<[String]>::is_empty")]
+    warnings: &'a [String],
+}
+
+fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
+    let (status, reason, error, reduction) = match &t.result {
+        Ok(r) => {
+            let reason = r.suspect_reason();
+            let reduction = Reduction {
+                peaks: &r.analysis.peaks,
+                contact_phases: r.analysis.contact_phases,
+                coefficients: &r.coefficients,
+                u: r.uncertainty.as_ref().map(Uncertainties),
+                release_time_s: r.analysis.release_time_s,
+                impacts: &r.analysis.impacts,
+            };
+            (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
+        }
+        Err(e) => ("error", None, Some(e.as_str()), None),
+    };
+    TestDoc {
+        id: &t.spec.id,
+        status,
+        reason,
+        error,
+        reduction,
+        exclude_from_mean: t.spec.exclude_from_mean,
+        warnings: &t.warnings,
+    }
+}
+
+#[derive(serde::Serialize)]
+struct LeftOut<'a> {
+    id: &'a str,
+    why: &'a str,
+}
+
+/// The whole document.
+#[derive(serde::Serialize)]
+struct SummaryDoc<'a> {
+    campaign: &'a str,
+    rocking: &'a str,
+    alpha_rad: f64,
+    alpha_source: String,
+    e_housner: f64,
+    e_housner_source: String,
+    method: String,
+    tests: Vec<TestDoc<'a>>,
+    mean: Option<&'a Means>,
+    mean_u: Option<&'a Means>,
+    mean_included: &'a [String],
+    mean_left_out: Vec<LeftOut<'a>>,
+}
+
+/// Build the summary document (SPEC "the output contract"); its keys sorted as
+/// `serde_json::Value` keeps them.
+pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
     let c = &res.campaign;
-    let tests: Vec<Value> = res
-        .tests
-        .iter()
-        .map(|t| {
-            let mut m = Map::new();
-            m.insert("id".into(), json!(t.spec.id));
-            match &t.result {
-                Ok(r) => {
-                    match r.suspect_reason() {
-                        None => m.insert("status".into(), json!("ok")),
-                        Some(why) => {
-                            m.insert("status".into(), json!("suspect"));
-                            m.insert("reason".into(), json!(why))
-                        }
-                    };
-                    m.insert("peaks".into(), json!(r.analysis.peaks));
-                    m.insert("contact_phases".into(), json!(r.analysis.contact_phases));
-                    if let Some(u) = &r.uncertainty {
-                        let names = ["e", "e_plus", "e_minus", "r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
-                        for (k, v) in names.iter().zip(u.to_array()) {
-                            m.insert(format!("{k}_u"), json!(v));
-                        }
-                    }
-                    let q = &r.coefficients;
-                    for (k, v) in [
-                        ("e", q.e),
-                        ("e_plus", q.e_plus),
-                        ("e_minus", q.e_minus),
-                        ("r", q.r),
-                        ("r_plus", q.r_plus),
-                        ("r_minus", q.r_minus),
-                        ("r1", q.r1),
-                        ("r1_plus", q.r1_plus),
-                        ("r1_minus", q.r1_minus),
-                        ("r2", q.r2),
-                    ] {
-                        m.insert(k.into(), json!(v));
-                    }
-                    m.insert("release_time_s".into(), json!(r.analysis.release_time_s));
-                    m.insert("impacts".into(), json!(r.analysis.impacts));
-                }
-                Err(e) => {
-                    m.insert("status".into(), json!("error"));
-                    m.insert("error".into(), json!(e));
-                }
-            }
-            m.insert("exclude_from_mean".into(), json!(t.spec.exclude_from_mean));
-            if !t.warnings.is_empty() {
-                m.insert("warnings".into(), json!(t.warnings));
-            }
-            Value::Object(m)
-        })
-        .collect();
-    let mean = res.means.means.map(|m| {
-        json!({"r": m.r, "r_plus": m.r_plus, "r_minus": m.r_minus, "r1": m.r1,
-               "r1_plus": m.r1_plus, "r1_minus": m.r1_minus, "r2": m.r2})
-    });
-    let mean_u = res.means.means_u.map(|m| serde_json::to_value(m).unwrap_or(Value::Null));
-    json!({
-        "campaign": c.name,
-        "rocking": c.rocking.as_str(),
-        "alpha_rad": c.alpha_rad,
-        "alpha_source": c.alpha_source.to_string(),
-        "e_housner": c.e_housner,
-        "e_housner_source": c.e_housner_source.to_string(),
-        "method": res.options.method.describe(),
-        "tests": tests,
-        "mean": mean.unwrap_or(Value::Null),
-        "mean_u": mean_u.unwrap_or(Value::Null),
-        "mean_included": res.means.included,
-        "mean_left_out": res.means.left_out.iter().map(|(id, why)| json!({"id": id, "why": why})).collect::<Vec<_>>(),
-    })
+    let doc = SummaryDoc {
+        campaign: &c.name,
+        rocking: c.rocking.as_str(),
+        alpha_rad: c.alpha_rad,
+        alpha_source: c.alpha_source.to_string(),
+        e_housner: c.e_housner,
+        e_housner_source: c.e_housner_source.to_string(),
+        method: res.options.method.describe(),
+        tests: res.tests.iter().map(test_doc).collect(),
+        mean: res.means.means.as_ref(),
+        mean_u: res.means.means_u.as_ref(),
+        mean_included: &res.means.included,
+        mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
+    };
+    Ok(serde_json::to_value(doc)?)
 }

@@ -1,0 +1,130 @@
+//! The outputs of `rocklab reduce` (and the base of `calibrate`'s): summary.json,
+//! Tables 1–3 as CSV, Markdown and LaTeX, the per-test plots (paper Fig. 3/4 and
+//! Fig. 5) and report.html.
+
+use rayon::prelude::*;
+
+use super::html;
+use super::plots::{self, Figure, Panel, Series};
+use super::{tables, Files, InputFile, ReportError};
+use crate::reduce::{CampaignResult, Reduced};
+use crate::restitution::local_ratios;
+
+/// What a later step (the calibration) adds to the reduce outputs: keys of
+/// summary.json and sections of report.html.
+#[derive(Debug, Default)]
+pub struct Extras {
+    pub summary: serde_json::Map<String, serde_json::Value>,
+    pub html_sections: Vec<String>,
+}
+
+/// The inputs as the load step read them: the manifest's text and every input
+/// file's size and SHA-256 (the manifest first, then the logs).
+#[derive(Debug, Clone, Default)]
+pub struct Sources {
+    pub manifest: String,
+    pub files: Vec<InputFile>,
+}
+
+/// The figures of one test: its id, the motion (Fig. 3/4) and the ratios (Fig. 5).
+pub type TestFigures = Vec<(String, Figure, Figure)>;
+
+/// Everything `reduce` produces: summary.json, tables (CSV, Markdown, LaTeX),
+/// per-test plots (PNG and SVG in `plots/`) unless `with_plots` is false, and the
+/// self-contained report.html, with what `extra` adds.
+pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, extra: &Extras) -> Result<Files, ReportError> {
+    let mut files = Files::default();
+    let mut doc = super::summary::summary(res)?;
+    if let Some(map) = doc.as_object_mut() {
+        map.extend(extra.summary.clone());
+    }
+    files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
+    let tabs = tables::tables(res);
+    table_files(res, &tabs, &mut files)?;
+    let figs: TestFigures = if with_plots {
+        res.tests
+            .par_iter()
+            .filter_map(|t| t.result.as_ref().ok().map(|r| (t.spec.id.as_str(), r)))
+            .map(|(id, r)| test_plots(id, r, res.campaign.e_housner).map(|(m, q)| (id.to_string(), m, q)))
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        Vec::new()
+    };
+    for (id, motion, ratios) in &figs {
+        motion.add_to(&mut files, &format!("plots/{id}_motion"));
+        ratios.add_to(&mut files, &format!("plots/{id}_ratios"));
+    }
+    let page = html::reduce_page(res, &tabs, &figs, &extra.html_sections, sources);
+    files.add("report.html", page);
+    Ok(files)
+}
+
+/// Each table as `NAME.csv` and `NAME.md`, all of them in tables.md and tables.tex.
+fn table_files(res: &CampaignResult, tabs: &[tables::Table], files: &mut Files) -> Result<(), ReportError> {
+    let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
+    let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
+    for t in tabs {
+        files.add(format!("{}.csv", t.name), tables::to_csv(t)?);
+        let one = tables::to_markdown(t);
+        files.add(format!("{}.md", t.name), one.as_bytes());
+        md.push_str(&one);
+        md.push('\n');
+        tex.push_str(&tables::to_latex(t));
+        tex.push('\n');
+    }
+    md.push_str(&format!("Velocity peaks: {}.\n", res.options.method.describe()));
+    files.add("tables.md", md);
+    files.add("tables.tex", tex);
+    Ok(())
+}
+
+/// Paper Fig. 3/4 (displacement and velocity with the peaks) and Fig. 5 (local
+/// ratios with their mean) for one test.
+fn test_plots(id: &str, r: &Reduced, e_h: f64) -> Result<(Figure, Figure), ReportError> {
+    let a = &r.analysis;
+    let t = &r.log.time_s;
+    let last = a.impacts.last().map_or(a.release_time_s + 1.0, |i| i.time_s);
+    let span = last - a.release_time_s;
+    let (t0, t1) = (a.release_time_s - 0.15 * span, last + 0.25 * span);
+    let window = |i: &usize| t[*i] >= t0 && t[*i] <= t1;
+    let idx: Vec<usize> = (0..t.len()).filter(window).collect();
+    let measured: Vec<(f64, f64)> = idx.iter().map(|&i| (t[i], a.displacement_mm[i])).collect();
+    let velocity: Vec<(f64, f64)> = idx.iter().map(|&i| (t[i], a.velocity_mm_s[i])).collect();
+    let fit_x: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.1)).collect();
+    let fit_v: Vec<(f64, f64)> = a.fit_curve.iter().map(|p| (p.0, p.2)).collect();
+    let peaks: Vec<(f64, f64)> = a.peaks.iter().map(|p| (p.time_s, p.velocity_mm_s)).collect();
+    let mut disp = vec![Series::line("measured (zero: final rest line)", plots::GREY, measured)];
+    let mut vel = vec![Series::line("velocity (per sample)", plots::GREY, velocity)];
+    if !fit_x.is_empty() {
+        disp.push(Series::line("free-rocking fit", plots::RED, fit_x));
+        vel.push(Series::line("fit, one-sided at impacts", plots::BLUE, fit_v));
+    }
+    vel.push(Series::dots("peaks v_k", plots::RED, peaks));
+    let motion = [
+        Panel::new(
+            format!("Test {id}: displacement at the sensor (outward +)"),
+            "time (s)",
+            "displacement (mm)",
+            disp,
+        ),
+        Panel::new(format!("Test {id}: velocity and its peaks"), "time (s)", "velocity (mm/s)", vel),
+    ];
+    let motion_fig = plots::render(&motion, 1000, 340)?;
+    let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
+    let local: Vec<(f64, f64)> = local_ratios(&v).iter().enumerate().map(|(k, q)| ((k + 1) as f64, q / e_h)).collect();
+    let n = local.len();
+    let ratios = [Panel {
+        hline: Some((r.coefficients.r, format!("mean r = {:.2}", r.coefficients.r))),
+        // Impacts are counted: the axis names 1, 2, … (no ticks between them).
+        x_names: (1..=n).map(|k| k.to_string()).collect(),
+        x_range: Some((0.5, n as f64 + 0.5)),
+        ..Panel::new(
+            format!("Test {id}: local ratios |v_k+1 / v_k| / e_H (Eq. 3)"),
+            "impact",
+            "ratio",
+            vec![Series::dots("local ratio", plots::RED, local)],
+        )
+    }];
+    let ratios_fig = plots::render(&ratios, 800, 400)?;
+    Ok((motion_fig, ratios_fig))
+}

@@ -88,7 +88,10 @@ fn peak_options(method: &str, window: usize, order: usize) -> anyhow::Result<Pea
         "savgol" => Method::SavGol(SavGol::new(window, order).map_err(anyhow::Error::msg)?),
         other => bail!("method = {other:?}: expected \"segments\" or \"savgol\""),
     };
-    Ok(PeakOptions { n_peaks: 6, method })
+    Ok(PeakOptions {
+        method,
+        ..PeakOptions::default()
+    })
 }
 
 /// The reduce result for Python: `summary` (exactly the CLI's summary.json),

@@ -17,7 +17,10 @@ pub fn options(e: &EstimatorArgs) -> anyhow::Result<PeakOptions> {
         MethodArg::Segments => Method::Segments,
         MethodArg::Savgol => Method::SavGol(SavGol::new(e.window, e.order).map_err(anyhow::Error::msg)?),
     };
-    Ok(PeakOptions { n_peaks: 6, method })
+    Ok(PeakOptions {
+        method,
+        ..PeakOptions::default()
+    })
 }
 
 pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {

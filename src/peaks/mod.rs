@@ -112,6 +112,8 @@ pub struct PeakOptions {
     /// Number of velocity peaks wanted (the tables need 6).
     pub n_peaks: usize,
     pub method: Method,
+    /// Which impact model the default estimator takes.
+    pub contacts: ContactModel,
 }
 
 impl Default for PeakOptions {
@@ -119,8 +121,24 @@ impl Default for PeakOptions {
         PeakOptions {
             n_peaks: 6,
             method: Method::Segments,
+            contacts: ContactModel::FromLog,
         }
     }
+}
+
+/// How the default estimator chooses between instantaneous impacts and contact
+/// phases.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactModel {
+    /// Contact phases only where this log asks for them (Bayesian information
+    /// criterion).
+    #[default]
+    FromLog,
+    /// Contact phases wherever they fit the log better than instantaneous
+    /// impacts at all: for a test whose campaign has shown finite-duration
+    /// contacts on the same wall while its own log (a low rate, a high noise)
+    /// cannot show them (see `reduce`).
+    Expected,
 }
 
 /// Why a log could not be analysed.
@@ -233,7 +251,7 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
     let prepared = prepare_log(t, x, opts.n_peaks)?;
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
-        Method::Segments => by_segments(t, prepared, phys, opts.n_peaks),
+        Method::Segments => by_segments(t, prepared, phys, opts.n_peaks, opts.contacts),
     }
 }
 
@@ -325,7 +343,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
-fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize) -> Result<Analysis, PeakError> {
+fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts: ContactModel) -> Result<Analysis, PeakError> {
     let fit = SegmentFit::run(&FitInput {
         t,
         x: &p.x,
@@ -335,6 +353,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize) -> Result
         crossings: &p.crossings,
         phys,
         n_peaks,
+        contacts,
     })?;
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);

@@ -18,6 +18,18 @@ pub enum FitStop {
     Stalled,
 }
 
+/// Why there is no fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum FitError {
+    /// The residual function is undefined at the starting point (a replay outside
+    /// the model's domain).
+    #[error("the residuals are undefined at the starting point")]
+    UndefinedStart,
+    /// Fewer residuals than parameters: the data cannot determine them.
+    #[error("{residuals} residuals for {parameters} parameters: expected at least as many residuals")]
+    Underdetermined { residuals: usize, parameters: usize },
+}
+
 /// Result of a fit.
 #[derive(Debug, Clone)]
 pub struct FitResult {
@@ -32,12 +44,28 @@ pub struct FitResult {
     pub covariance: Option<DMatrix<f64>>,
 }
 
-/// Finite-difference steps: `steps[j]` absolute step of parameter j.
-pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync)) -> Option<FitResult> {
+/// Residuals of a parameter vector, None where they are undefined.
+pub type Residuals<'a> = dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync + 'a;
+
+/// As [`least_squares`], None instead of the reason (for callers that only need to
+/// know whether there is a fit, e.g. the estimator's arc fits).
+pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &Residuals) -> Option<FitResult> {
+    least_squares(q0, steps, max_iter, residuals).ok()
+}
+
+/// Minimise the sum of squared `residuals` from `q0` by Levenberg–Marquardt;
+/// finite-difference steps: `steps[j]` absolute step of parameter j.
+pub fn least_squares(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &Residuals) -> Result<FitResult, FitError> {
     let mut q = q0.to_vec();
-    let mut r = residuals(&q)?;
+    let mut r = residuals(&q).ok_or(FitError::UndefinedStart)?;
     let n = r.len();
     let np = q.len();
+    if n < np {
+        return Err(FitError::Underdetermined {
+            residuals: n,
+            parameters: np,
+        });
+    }
     let mut cost: f64 = r.iter().map(|v| v * v).sum();
     let mut mu = 1e-3;
     let mut stop = FitStop::MaxIterations;
@@ -116,7 +144,7 @@ pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals
     let jac = jacobian(&q, &r);
     let dof = n.saturating_sub(np).max(1) as f64;
     let covariance = covariance(jac.tr_mul(&jac)).map(|m| m * (cost / dof));
-    Some(FitResult {
+    Ok(FitResult {
         q,
         cost,
         residuals: r,

@@ -53,7 +53,7 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     for t in &res.tests {
         assert!(t.result.is_ok(), "{}: {:?}", t.spec.id, t.result.as_ref().err());
     }
-    let cal = calibrate(&res, 6);
+    let cal = calibrate(&res.calibration_input(), 6);
     assert!(cal.failed.is_empty(), "{:?}", cal.failed);
     for f in &cal.tests {
         println!(
@@ -81,12 +81,12 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     // calibration.toml round-trips into the readers of simulate and the façade study.
     let toml_path = Path::new(dir.path()).join("calibration.toml");
     std::fs::write(&toml_path, rocklab::calibrate::to_toml(&cal)).unwrap();
-    let (ei, eo) = rocklab::facade::read_calibration(&toml_path).unwrap();
+    let (ei, eo) = rocklab::ingest::calibration::read_coefficients(&toml_path).unwrap();
     assert_eq!((ei, eo), (cal.e_in, cal.e_out));
     // Issue 10: it carries what a façade ensemble draws from, and the study's
     // calibration set draws e_in ~ N(mean, √(sd_tests² + se_fit²)).
-    let file = rocklab::facade::read_calibration_file(&toml_path).unwrap();
-    let sp = file.spread.expect("[calibration.spread]");
+    let file = rocklab::ingest::calibration::read(&toml_path).unwrap().calibration;
+    let sp = file.spread.clone().expect("[calibration.spread]").spread;
     let inc: Vec<_> = cal.tests.iter().filter(|t| cal.included.contains(&t.id)).collect();
     assert_eq!(sp.n_tests, inc.len());
     let n = inc.len() as f64;

@@ -35,7 +35,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
 
 pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow::Result<Calibration> {
     let start = std::time::Instant::now();
-    let cal = calibrate(res, n);
+    let cal = calibrate(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
     std::fs::create_dir_all(out)?;
     write_atomic(&out.join("calibration.toml"), to_toml(&cal).as_bytes())?;
@@ -97,7 +97,7 @@ fn calibration_html(cal: &Calibration, n: usize, figs: &[(String, String)]) -> S
     use rocklab::report::html::escape;
     let mut s = format!(
         "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
-        if cal.rocking == "one-sided" { " and inward spring" } else { "" },
+        if cal.rocking == rocklab::wall::Rocking::OneSided { " and inward spring" } else { "" },
         escape(&cal.included.join(", ")),
         cal.e_in,
         cal.r_in,

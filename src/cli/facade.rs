@@ -138,7 +138,7 @@ fn fragility_runs(
             "fragility runs",
         );
         let start = std::time::Instant::now();
-        samples_owned = run_ida_samples(study, sc, n, &|| pb.inc(1));
+        samples_owned = run_ida_samples(study, sc, n, &|| pb.inc(1))?;
         pb.finish_and_clear();
         source = format!(
             "IDA over {} scale factors ({:.3}–{:.3} × the magnification), {} sample{} per record × polarity × set at each ({} runs, {:.2} s)",
@@ -268,7 +268,7 @@ fn md_table_to_html(md: &str, id: &str) -> String {
 pub fn study_outputs(study: &Study, out: &Path) -> anyhow::Result<(Vec<StudyRun>, Figures, String)> {
     let pb = progress(study.combinations().len(), "façade runs");
     let start = std::time::Instant::now();
-    let runs = run_study(study, 1.0, true, &|| pb.inc(1));
+    let runs = run_study(study, 1.0, true, &|| pb.inc(1))?;
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     say(&format!("{} nominal runs (each at 3 tolerances) in {wall:.2} s", runs.len()));
@@ -411,7 +411,7 @@ fn ida_outputs(study: &Study, scales: &[f64], out: &Path) -> anyhow::Result<Figu
     let n = scales.len() * study.combinations().len();
     let pb = progress(n, "IDA runs");
     let start = std::time::Instant::now();
-    let pts = run_ida(study, scales, &|| pb.inc(1));
+    let pts = run_ida(study, scales, &|| pb.inc(1))?;
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     let mut w = csv::Writer::from_writer(Vec::new());
@@ -502,7 +502,7 @@ fn ensemble_outputs(study: &Study, nominal: &[StudyRun], out: &Path) -> anyhow::
     let n = study.samples;
     let pb = progress(study.records.len() * study.rows().len() * study.sets.len() * n, "ensemble runs");
     let start = std::time::Instant::now();
-    let (rows, samples) = run_ensembles(study, n, &|| pb.inc(1));
+    let (rows, samples) = run_ensembles(study, n, &|| pb.inc(1))?;
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     say(&format!(

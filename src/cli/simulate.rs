@@ -112,9 +112,9 @@ fn coefficients_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result
 
 pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     let block = BlockSpec::load(&a.block)?;
-    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let record = rocklab::ingest::record::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
     let (e_in, e_out) = match &a.calibration {
-        Some(file) => rocklab::facade::read_calibration(file)?,
+        Some(file) => rocklab::ingest::calibration::read_coefficients(file)?,
         None => coefficients_from_args(&a, &block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
@@ -136,7 +136,7 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
         atol: a.atol,
         keep_history: true,
     };
-    let (summary, sim) = run(&block, &record, &spec);
+    let (summary, sim) = run(&block, &record, &spec)?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let alpha = block.block.alpha;
     let doc = rocklab::report::docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim);

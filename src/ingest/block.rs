@@ -29,7 +29,11 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::error::{FileError, FileKind};
+use crate::ingest::text::{parse_toml, read_text};
+pub use crate::solver::block::{BlockSpec, ImpactDefaults};
 use crate::solver::{Block, Restraint, TieRod};
+use crate::wall::Rectangle;
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -71,53 +75,33 @@ struct RawTie {
     yield_force_kn: Option<f64>,
 }
 
-/// Optional impact defaults of a block file.
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ImpactDefaults {
-    pub e: Option<f64>,
-    pub e_in: Option<f64>,
-    pub e_out: Option<f64>,
-    pub overturn_limit_rad: Option<f64>,
-}
-
 type RawImpact = ImpactDefaults;
 
-/// A validated block file.
-#[derive(Debug, Clone)]
-pub struct BlockSpec {
-    pub name: String,
-    pub block: Block,
-    pub restraint: Restraint,
-    pub ties: Vec<TieRod>,
-    pub impact: ImpactDefaults,
-    /// (K'_c in MN/m², contact height in m) when the restraint is given as a
-    /// spring bed (the façade ensembles vary them).
-    pub spring_bed: Option<(f64, f64)>,
-    /// Which of R, α, I_0, mass were overridden.
-    pub overrides: Vec<String>,
-}
+type Result<T> = std::result::Result<T, FileError>;
 
-fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
+fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(anyhow::anyhow!("{}: {key} = {v}: expected a positive number", path.display()))
+        Err(FileError::invalid(path, format!("{key} = {v}: expected a positive number")))
     }
 }
 
+/// The reader of a block file (the type is the solver's).
 impl BlockSpec {
-    pub fn load(path: &Path) -> anyhow::Result<BlockSpec> {
-        let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: cannot read block file: {e}", path.display()))?;
-        Self::parse(&text, path)
+    pub fn load(path: &Path) -> Result<BlockSpec> {
+        Self::parse(&read_text(path, FileKind::Block)?, path)
     }
 
-    pub fn parse(text: &str, path: &Path) -> anyhow::Result<BlockSpec> {
-        let raw: RawFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+    pub fn parse(text: &str, path: &Path) -> Result<BlockSpec> {
+        let raw: RawFile = parse_toml(text, path)?;
         let b = &raw.block;
-        let mut block = Block::rectangular(
+        let geom = Rectangle::new(
             positive(path, "[block].height_m", b.height_m)?,
             positive(path, "[block].thickness_m", b.thickness_m)?,
+        );
+        let mut block = Block::rectangular(
+            geom,
             positive(path, "[block].width_m", b.width_m)?,
             positive(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3)?,
         );
@@ -132,7 +116,7 @@ impl BlockSpec {
         }
         if let Some(a) = b.alpha_rad {
             if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
-                anyhow::bail!("{}: [block].alpha_rad = {a}: expected 0 < α < π/2", path.display());
+                return Err(FileError::invalid(path, format!("[block].alpha_rad = {a}: expected 0 < α < π/2")));
             }
             block.alpha = a;
             overrides.push("alpha_rad".into());
@@ -159,10 +143,12 @@ impl BlockSpec {
                 (None, None, Some(k)) => Restraint::Rotational {
                     k_nm_per_rad: positive(path, "rotational_stiffness_mnm_rad", k)? * 1e6,
                 },
-                _ => anyhow::bail!(
-                    "{}: [restraint]: give unit_stiffness_mn_m2 with contact_height_m, or rotational_stiffness_mnm_rad alone",
-                    path.display()
-                ),
+                _ => {
+                    return Err(FileError::invalid(
+                        path,
+                        "[restraint]: give unit_stiffness_mn_m2 with contact_height_m, or rotational_stiffness_mnm_rad alone",
+                    ))
+                }
             },
         };
         let ties = raw
@@ -178,7 +164,7 @@ impl BlockSpec {
                         .transpose()?,
                 })
             })
-            .collect::<anyhow::Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>>>()?;
         Ok(BlockSpec {
             name: b
                 .name

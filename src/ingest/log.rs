@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::InputError;
+pub use crate::reduction::LogData;
 
 /// Field delimiter of a log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -48,18 +49,6 @@ pub enum Decimal {
 pub struct LogFormat {
     pub delimiter: Option<Delimiter>,
     pub decimal: Option<Decimal>,
-}
-
-/// The two channels of one log, in seconds and millimetres, outward positive.
-#[derive(Debug, Clone, Default)]
-pub struct LogData {
-    pub time_s: Vec<f64>,
-    /// Displacement at the sensor, mm, positive OUTWARD (the file's sign × outward_sign).
-    pub disp_mm: Vec<f64>,
-    /// What was read and how, e.g. "delimiter ';' (detected)".
-    pub notes: Vec<String>,
-    /// Every warning raised while reading (a dropped truncated line, …).
-    pub warnings: Vec<String>,
 }
 
 /// Builder of a log reader: `LogReader::new(path).time("time_s", 1.0)…read()`.
@@ -105,17 +94,7 @@ impl LogReader {
 
     /// Read the file.
     pub fn read(&self) -> Result<LogData, InputError> {
-        let bytes = std::fs::read(&self.path).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::NotFound {
-                InputError::Missing { file: self.path.clone() }
-            } else {
-                InputError::Io {
-                    file: self.path.clone(),
-                    source: e,
-                }
-            }
-        })?;
-        self.parse(&bytes)
+        self.parse(&crate::ingest::text::read_bytes(&self.path)?)
     }
 
     /// Parse the bytes of a log (the path only names it in messages).

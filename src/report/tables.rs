@@ -67,7 +67,7 @@ fn build(res: &CampaignResult, name: &'static str, caption: String, cols: &[(&'s
                 .result
                 .as_ref()
                 .map(|r| cols.iter().map(|c| (c.2)(&r.coefficients)).collect())
-                .map_err(|e| e.clone()),
+                .map_err(|e| e.reason()),
             u: t.result
                 .as_ref()
                 .ok()
@@ -76,7 +76,7 @@ fn build(res: &CampaignResult, name: &'static str, caption: String, cols: &[(&'s
             suspect: t.result.as_ref().ok().and_then(|r| r.suspect_reason()),
         })
         .collect();
-    let as_coefficients = |m: &crate::tables::Means| Coefficients {
+    let as_coefficients = |m: &crate::campaign_means::Means| Coefficients {
         e: f64::NAN,
         e_plus: f64::NAN,
         e_minus: f64::NAN,
@@ -237,12 +237,9 @@ pub fn to_markdown(t: &Table) -> String {
     s
 }
 
-/// The reason in a few words for a table cell (the file path of an error dropped).
+/// The reason in a few words for a table cell (an error's reason comes without
+/// the file's path: `TestError::reason`).
 fn first_words(e: &str) -> String {
-    let e = match e.split_once(".csv: ") {
-        Some((_, rest)) => rest,
-        None => e,
-    };
     let short: String = e.chars().take(60).collect();
     let short = if e.chars().count() > 60 { format!("{short}…") } else { short };
     short.replace('|', "/")

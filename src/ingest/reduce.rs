@@ -1,0 +1,179 @@
+//! A campaign's reduction from its files: read each log as its manifest entry says,
+//! reduce it in memory ([`crate::reduction`]), compute the means
+//! ([`crate::campaign_means`]). One `Result` per test, so one broken test never
+//! stops the others. Re-exported at the crate root as `rocklab::reduce`.
+
+use std::path::PathBuf;
+
+use rayon::prelude::*;
+
+use crate::campaign_means::{campaign_means, CampaignMeans, Row};
+use crate::error::InputError;
+use crate::ingest::manifest::{Campaign, TestSpec};
+use crate::ingest::LogReader;
+use crate::peaks::{PeakOptions, Physics};
+pub use crate::reduction::{LogData, ReduceError, Reduced};
+
+/// Why a test of a campaign has no coefficients.
+#[derive(Debug, thiserror::Error)]
+pub enum TestError {
+    /// The log could not be read (file, line and column in the error).
+    #[error(transparent)]
+    Read(#[from] InputError),
+    /// The log was read but could not be reduced.
+    #[error("{}: {source}", file.display())]
+    Reduce {
+        file: PathBuf,
+        #[source]
+        source: ReduceError,
+    },
+}
+
+impl TestError {
+    /// The reason without the file's path when the whole file is at fault (a table
+    /// cell names the test already); a located read error keeps its line and column.
+    pub fn reason(&self) -> String {
+        match self {
+            TestError::Reduce { source, .. } => source.to_string(),
+            TestError::Read(e @ (InputError::At { .. } | InputError::Line { .. } | InputError::NoData { .. })) => e.to_string(),
+            TestError::Read(e) => {
+                let full = e.to_string();
+                let file = e.file().display().to_string();
+                full.strip_prefix(&format!("{file}: ")).map_or(full.clone(), str::to_string)
+            }
+        }
+    }
+}
+
+impl serde::Serialize for TestError {
+    /// As its message (summary.json: `"error": "…"`).
+    fn serialize<S: serde::Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
+        ser.collect_str(self)
+    }
+}
+
+/// The outcome of one test.
+#[derive(Debug)]
+pub struct TestOutcome {
+    pub spec: TestSpec,
+    pub result: Result<Reduced, TestError>,
+    /// Warnings raised while reading (kept even when the reduction failed later).
+    pub warnings: Vec<String>,
+}
+
+/// A reduced campaign.
+#[derive(Debug)]
+pub struct CampaignResult {
+    pub campaign: Campaign,
+    pub options: PeakOptions,
+    pub tests: Vec<TestOutcome>,
+    pub means: CampaignMeans,
+}
+
+impl CampaignResult {
+    /// (id, why) of every test that has no coefficients.
+    pub fn failed(&self) -> impl Iterator<Item = (&str, &TestError)> {
+        self.tests.iter().filter_map(|t| t.result.as_ref().err().map(|e| (t.spec.id.as_str(), e)))
+    }
+
+    /// The campaign as the calibration takes it (no paths, no file types).
+    pub fn calibration_input(&self) -> crate::calibrate::CampaignInput<'_> {
+        crate::calibrate::CampaignInput {
+            name: &self.campaign.name,
+            rocking: self.campaign.rocking,
+            wall: self.campaign.wall(),
+            tests: self
+                .tests
+                .iter()
+                .map(|t| crate::calibrate::TestInput {
+                    id: &t.spec.id,
+                    exclude_from_mean: t.spec.exclude_from_mean,
+                    lever_arm_m: t.spec.lever_arm_m,
+                    reduced: t.result.as_ref().map_err(|e| e as &(dyn std::error::Error + Sync)),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The physics the estimator starts from, for one test of a campaign.
+pub fn physics(campaign: &Campaign, spec: &TestSpec) -> Physics {
+    crate::reduction::physics(campaign.rocking, &campaign.wall(), spec.lever_arm_m)
+}
+
+/// Read one log as its manifest entry says.
+pub fn read_log(spec: &TestSpec) -> Result<LogData, InputError> {
+    LogReader::new(&spec.file)
+        .format(spec.format)
+        .time(&spec.time.column, spec.time.unit.to_s())
+        .displacement(&spec.displacement.column, spec.displacement.unit.to_mm() * spec.outward_sign)
+        .read()
+}
+
+/// Reduce one test: [`read_log`], then [`reduce_loaded`].
+pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) -> TestOutcome {
+    match read_log(spec) {
+        Ok(log) => reduce_loaded(campaign, spec, log, options),
+        Err(e) => TestOutcome {
+            spec: spec.clone(),
+            result: Err(e.into()),
+            warnings: Vec::new(),
+        },
+    }
+}
+
+/// Reduce one test whose log is already in memory (read by another reader, e.g.
+/// the Python binding's arrays): `log` must hold time in s and displacement in mm,
+/// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
+pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
+    let warnings = log.warnings.clone();
+    let result = crate::reduction::reduce_log(log, &physics(campaign, spec), campaign.e_housner, options).map_err(|source| TestError::Reduce {
+        file: spec.file.clone(),
+        source,
+    });
+    TestOutcome {
+        spec: spec.clone(),
+        result,
+        warnings,
+    }
+}
+
+/// Reduce every test of a campaign (in parallel) and compute the means.
+pub fn reduce_campaign(campaign: Campaign, options: PeakOptions) -> CampaignResult {
+    reduce_campaign_with(campaign, options, &|| {})
+}
+
+/// As [`reduce_campaign`], calling `tick` after each test (progress display).
+pub fn reduce_campaign_with(campaign: Campaign, options: PeakOptions, tick: &(dyn Fn() + Sync)) -> CampaignResult {
+    let tests: Vec<TestOutcome> = campaign
+        .tests
+        .par_iter()
+        .map(|s| {
+            let o = reduce_test(&campaign, s, &options);
+            tick();
+            o
+        })
+        .collect();
+    campaign_result(campaign, options, tests)
+}
+
+/// A campaign result from its reduced tests (one outcome per test of `campaign`,
+/// in order): the means over them, as [`reduce_campaign`] computes them.
+pub fn campaign_result(campaign: Campaign, options: PeakOptions, tests: Vec<TestOutcome>) -> CampaignResult {
+    let rows: Vec<Row> = tests
+        .iter()
+        .map(|t| Row {
+            id: t.spec.id.clone(),
+            exclude_from_mean: t.spec.exclude_from_mean,
+            coefficients: t.result.as_ref().ok().map(|r| r.coefficients),
+            suspect: t.result.as_ref().ok().and_then(|r| r.suspect_reason()),
+        })
+        .collect();
+    let means = campaign_means(&rows);
+    CampaignResult {
+        campaign,
+        options,
+        tests,
+        means,
+    }
+}

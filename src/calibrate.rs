@@ -436,7 +436,7 @@ pub struct Calibration {
 }
 
 /// What calibrating one test gave.
-struct Outcome {
+struct TestCalibration {
     id: String,
     exclude_from_mean: bool,
     fit: Result<(TestWindow, TestFit), TestFailure>,
@@ -445,7 +445,7 @@ struct Outcome {
 }
 
 /// Window and fit one reduced test.
-fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usize) -> Outcome {
+fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usize) -> TestCalibration {
     let (fit, per_impact) = match t.reduced {
         Err(e) => (Err(TestFailure::NotReduced(e.to_string())), None),
         Ok(r) => {
@@ -455,7 +455,7 @@ fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usi
             (fit, Some(per_impact(r, n_impacts)))
         }
     };
-    Outcome {
+    TestCalibration {
         id: t.id.to_string(),
         exclude_from_mean: t.exclude_from_mean,
         fit,
@@ -468,7 +468,7 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
     use rayon::prelude::*;
     let geom = Geometry::of(c.rocking, &c.wall);
     let single_e = c.rocking == Rocking::TwoSided;
-    let outcomes: Vec<Outcome> = c.tests.par_iter().map(|t| calibrate_test(t, &geom, single_e, n_impacts)).collect();
+    let outcomes: Vec<TestCalibration> = c.tests.par_iter().map(|t| calibrate_test(t, &geom, single_e, n_impacts)).collect();
     let mut tests = Vec::new();
     let mut windows = Vec::new();
     let mut included = Vec::new();
@@ -638,13 +638,11 @@ impl CalibrationFile {
 
 /// calibration.toml of a calibration: a comment saying what the values are, then
 /// [`CalibrationFile`].
-pub fn to_toml(c: &Calibration) -> String {
+pub fn to_toml(c: &Calibration) -> Result<String, toml::ser::Error> {
     let header = format!(
         "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them.\n",
         c.included.join(", "),
         if c.rocking == Rocking::OneSided { ", inward spring" } else { "" },
     );
-    // A struct of numbers, strings and tables always serialises.
-    let body = toml::to_string(&CalibrationFile::of(c)).expect("calibration.toml serialises");
-    header + &body
+    Ok(header + &toml::to_string(&CalibrationFile::of(c))?)
 }

@@ -499,12 +499,12 @@ pub fn fragility_by_set(study: &Study, runs: &[SampleRun]) -> Vec<SetFragility> 
             keys.sort();
             keys.dedup();
             for (rec, sc) in keys {
-                let g: Vec<&&SampleRun> = mine.iter().filter(|r| r.record == rec && r.scale.to_bits() == sc).collect();
-                let n = g.len();
+                let group: Vec<&&SampleRun> = mine.iter().filter(|r| r.record == rec && r.scale.to_bits() == sc).collect();
+                let n = group.len();
                 observed.push(Trial {
-                    im: g.iter().map(|r| r.im).sum::<f64>() / n as f64,
+                    im: group.iter().map(|r| r.im).sum::<f64>() / n as f64,
                     n,
-                    k: g.iter().filter(|r| r.outcome.overturned).count(),
+                    k: group.iter().filter(|r| r.outcome.overturned).count(),
                 });
             }
             observed.sort_by(|a, b| a.im.total_cmp(&b.im));

@@ -38,7 +38,7 @@ pub fn calibrate_and_write(res: &CampaignResult, out: &Path, n: usize) -> anyhow
     let cal = calibrate(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
     std::fs::create_dir_all(out)?;
-    write_atomic(&out.join("calibration.toml"), to_toml(&cal).as_bytes())?;
+    write_atomic(&out.join("calibration.toml"), to_toml(&cal)?.as_bytes())?;
     let calibration = rocklab::report::docs::calibration_summary(&cal, wall);
     // Everything reduce writes, with the calibration in summary.json and report.html.
     let figs = plots_for(res, &cal, out, n)?;

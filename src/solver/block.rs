@@ -27,8 +27,13 @@ impl Block {
             r_m: r,
             alpha: geom.slenderness(),
             mass_kg: mass,
-            i0: 4.0 / 3.0 * mass * r * r,
+            i0: Block::rectangular_i0(mass, r),
         }
+    }
+
+    /// I_0 = 4/3 m R² of a rectangular block of mass m and half-diagonal R.
+    pub fn rectangular_i0(mass_kg: f64, r_m: f64) -> f64 {
+        4.0 / 3.0 * mass_kg * r_m * r_m
     }
 
     /// p² = m g R / I_0 (s⁻²); 3g/(4R) for a rectangular block.

@@ -513,44 +513,44 @@ fn track_extremum(sim: &mut Simulation, d: &Dense, t: f64, h: f64, y0: &State, y
 }
 
 /// The first record sample strictly after t (or +∞ past the record).
-fn next_sample_after(g: &Ground, t: f64) -> f64 {
-    if g.acc.len() < 2 || t >= g.end() {
+fn next_sample_after(ground: &Ground, t: f64) -> f64 {
+    if ground.acc.len() < 2 || t >= ground.end() {
         return f64::INFINITY;
     }
-    if t < g.t0 {
-        return g.t0;
+    if t < ground.t0 {
+        return ground.t0;
     }
-    let k = ((t - g.t0) / g.dt * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
-    g.t0 + g.dt * k
+    let k = ((t - ground.t0) / ground.dt * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    ground.t0 + ground.dt * k
 }
 
 /// The time after which |ü_g| ≤ threshold for good: the end of the interval after
 /// the last sample above it (ü_g is linear between samples, so it can only exceed
 /// the threshold next to such a sample); the record's start if none is.
-fn quiet_after(g: &Ground, thr: f64) -> f64 {
-    match g.acc.iter().rposition(|a| a.abs() > thr) {
-        Some(i) => g.time((i + 1).min(g.acc.len().saturating_sub(1))),
-        None => g.t0,
+fn quiet_after(ground: &Ground, thr: f64) -> f64 {
+    match ground.acc.iter().rposition(|a| a.abs() > thr) {
+        Some(i) => ground.time((i + 1).min(ground.acc.len().saturating_sub(1))),
+        None => ground.t0,
     }
 }
 
 /// Next time ≥ t when |ü_g| exceeds the threshold (exact on the piecewise-linear
 /// record), and the side the wall rocks towards (the sign of ü_g).
-fn next_uplift(g: &Ground, t: f64, t_end: f64, thr: f64) -> Option<(f64, Side)> {
-    let a_now = g.at(t);
+fn next_uplift(ground: &Ground, t: f64, t_end: f64, thr: f64) -> Option<(f64, Side)> {
+    let a_now = ground.at(t);
     if a_now.abs() > thr {
         return Some((t, Side::of(a_now)));
     }
-    if g.acc.len() < 2 || t >= g.end() {
+    if ground.acc.len() < 2 || t >= ground.end() {
         return None;
     }
-    let start = g.interval(t.max(g.t0));
-    for i in start..g.acc.len() - 1 {
-        let (ta, tb) = (g.time(i), g.time(i + 1));
+    let start = ground.interval(t.max(ground.t0));
+    for i in start..ground.acc.len() - 1 {
+        let (ta, tb) = (ground.time(i), ground.time(i + 1));
         if ta > t_end {
             return None;
         }
-        let (a, b) = (g.acc[i], g.acc[i + 1]);
+        let (a, b) = (ground.acc[i], ground.acc[i + 1]);
         for sgn in [1.0, -1.0] {
             let (fa, fb) = (sgn * a - thr, sgn * b - thr);
             if fb > 0.0 && fa <= 0.0 {

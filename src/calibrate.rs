@@ -646,3 +646,67 @@ pub fn to_toml(c: &Calibration) -> Result<String, toml::ser::Error> {
     );
     Ok(header + &toml::to_string(&CalibrationFile::of(c))?)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wall::Provenance;
+
+    fn wall() -> Wall {
+        Wall {
+            height_m: 2.70,
+            thickness_m: 0.36,
+            hinge_height_m: 0.23,
+            alpha_rad: 0.133,
+            alpha_source: Provenance::Computed("test".into()),
+            e_housner: 0.974,
+            e_housner_source: Provenance::Computed("test".into()),
+        }
+    }
+
+    /// A window whose release lies beyond the lever arm cannot be replayed from
+    /// any start: the failure says so (it used to be "the fit failed").
+    #[test]
+    fn a_window_that_cannot_be_replayed_says_why() {
+        let geom = Geometry::of(Rocking::OneSided, &wall());
+        let w = TestWindow {
+            id: "x".into(),
+            t: (0..100).map(|i| 1.0 + i as f64 * 0.01).collect(),
+            x_mm: vec![0.0; 100],
+            release_s: 1.0,
+            x_release_mm: 3000.0,
+            lever_mm: 2330.0,
+            t_end: 2.0,
+        };
+        let e = fit_test(&w, &geom, false).unwrap_err();
+        assert_eq!(e, TestFailure::NoStart);
+        assert!(e.to_string().starts_with("the fit failed: no starting point"), "{e}");
+    }
+
+    /// A test that was not reduced is listed as failed with the reduction's reason.
+    #[test]
+    fn a_test_not_reduced_is_failed_with_its_reason() {
+        let err = std::io::Error::other("x.csv: file not found");
+        let input = CampaignInput {
+            name: "c",
+            rocking: Rocking::TwoSided,
+            wall: wall(),
+            tests: vec![TestInput {
+                id: "a",
+                exclude_from_mean: false,
+                lever_arm_m: 2.33,
+                reduced: Err(&err),
+            }],
+        };
+        let cal = calibrate(&input, 6);
+        assert_eq!(
+            cal.failed,
+            vec![("a".to_string(), TestFailure::NotReduced("x.csv: file not found".into()))]
+        );
+        assert_eq!(
+            serde_json::to_value(&cal.failed[0].1).unwrap(),
+            serde_json::json!("not reduced: x.csv: file not found")
+        );
+        assert!(cal.joint.is_none() && cal.tests.is_empty());
+    }
+}

@@ -214,4 +214,17 @@ mod tests {
         );
         assert_eq!(res.stop, FitStop::Converged);
     }
+
+    /// A fit that cannot start says why (it used to be a bare None).
+    #[test]
+    fn a_failed_fit_says_why() {
+        let undefined = |_: &[f64]| None;
+        assert_eq!(least_squares(&[1.0], &[1e-7], 10, &undefined).unwrap_err(), FitError::UndefinedStart);
+        let one = |q: &[f64]| Some(vec![q[0] - 1.0]);
+        assert_eq!(
+            least_squares(&[0.0, 0.0], &[1e-7, 1e-7], 10, &one).unwrap_err(),
+            FitError::Underdetermined { residuals: 1, parameters: 2 }
+        );
+        assert!(levenberg_marquardt(&[1.0], &[1e-7], 10, &undefined).is_none());
+    }
 }

@@ -248,3 +248,33 @@ fn one_sided_free_rocking_ends_at_rest() {
     assert!(sim.min_theta > -0.05 && sim.min_theta < 0.0);
     assert!(sim.steps < 200_000, "{} steps", sim.steps);
 }
+
+/// Issue #12: settings the solver cannot run with are an error that says which,
+/// not a panic (they used to assert!).
+#[test]
+fn unusable_settings_are_errors_not_panics() {
+    use rocklab::solver::run::SolverError;
+    let m = model(0.9, 0.9, false);
+    let run = |s: &Settings, initial: Option<[f64; 2]>| simulate(&m, &quiet(), 0.0, initial, s);
+    let e = run(&Settings::new(1.0).with_tolerances(0.0, 1e-12), None).unwrap_err();
+    assert_eq!(e, SolverError::Tolerances { rtol: 0.0, atol: 1e-12 });
+    assert!(e.to_string().contains("rtol = 0"), "{e}");
+    let mut s = Settings::new(1.0);
+    s.max_step = 0.0;
+    assert!(matches!(run(&s, None), Err(SolverError::NotPositive { what: "max_step", .. })));
+    assert!(matches!(run(&Settings::new(f64::NAN), None), Err(SolverError::EndTime { .. })));
+    assert!(matches!(
+        run(&Settings::new(1.0), Some([f64::NAN, 0.0])),
+        Err(SolverError::Initial { .. })
+    ));
+    let flat = Ground {
+        t0: 0.0,
+        dt: 0.0,
+        acc: vec![0.0; 2],
+    };
+    assert!(matches!(
+        simulate(&m, &flat, 0.0, None, &Settings::new(1.0)),
+        Err(SolverError::Ground { .. })
+    ));
+    assert!(run(&Settings::new(1.0), Some([0.5 * ALPHA, 0.0])).is_ok());
+}

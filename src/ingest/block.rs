@@ -168,7 +168,10 @@ impl BlockSpec {
     }
 
     pub fn parse(text: &str, path: &Path) -> Result<BlockSpec> {
-        let raw: RawFile = parse_toml(text, path)?;
+        Self::validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
+    }
+
+    fn validate(raw: RawFile, path: &Path) -> Result<BlockSpec> {
         let (block, overrides) = block(&raw.block, path)?;
         let (restraint, spring_bed) = restraint(raw.restraint.as_ref(), path)?;
         let ties = raw.tie_rod.iter().map(|t| tie_rod(t, path)).collect::<Result<Vec<_>>>()?;

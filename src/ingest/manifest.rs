@@ -191,7 +191,7 @@ impl Campaign {
     /// Parse and validate manifest text; `path` names it in errors and resolves the
     /// test files.
     pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
-        validate(parse_toml(text, path)?, path)
+        validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
     }
 }
 

@@ -319,7 +319,11 @@ fn choices(path: &Path, h: &RawHead) -> Result<(Vec<f64>, PolarityMode, Im)> {
 impl Study {
     /// Read and validate a study file and everything it names.
     pub fn load(path: &Path) -> Result<Study> {
-        let raw: RawStudy = parse_toml(&read_text(path, FileKind::Study)?, path)?;
+        let text = read_text(path, FileKind::Study)?;
+        Self::validate(parse_toml(&text, path)?, path).map_err(|e| e.located(path, &text))
+    }
+
+    fn validate(raw: RawStudy, path: &Path) -> Result<Study> {
         let base = path.parent().unwrap_or_else(|| Path::new("."));
         let block = BlockSpec::load(&base.join(&raw.study.block))?;
         let h = &raw.study;

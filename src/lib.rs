@@ -11,8 +11,9 @@
 //!   Dormand–Prince 5(4) scheme in [`solver::integrator`], event by event in
 //!   [`solver::run`] (impacts, rest, uplift, overturning).
 //! - Eq. 2 (Housner's e_H = 1 − 1.5 sin²α): [`wall::housner_e`].
-//! - Eqs. 3–6 (the ratios r, r₁, r₂ of the velocity peaks and their
-//!   uncertainties): [`restitution`].
+//! - Eqs. 3–6 (e from the ratios of successive velocity peaks, e⁺ and e⁻ by
+//!   side, r = e / e_H; Tables 1–3's r₁, r₂) and their uncertainties:
+//!   [`restitution`].
 //! - The estimator of the velocity peaks (damped arcs fitted to the free-rocking
 //!   segments): [`peaks`], called per test by [`reduction`]; the campaign means
 //!   in [`campaign_means`].

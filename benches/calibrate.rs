@@ -16,5 +16,6 @@ fn main() {
 fn calibrate_one_sided_demo(bencher: divan::Bencher) {
     let m = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/one-sided-demo/campaign.toml");
     let res = reduce_campaign(Campaign::load(&m).unwrap(), PeakOptions::default());
-    bencher.bench(|| divan::black_box(calibrate(&res, 6).e_in));
+    let input = res.calibration_input();
+    bencher.bench(|| divan::black_box(calibrate(&input, 6).e_in));
 }

@@ -16,7 +16,7 @@ fn facade_ensemble_10000_runs(bencher: divan::Bencher) {
     let rows = study.records.len() * study.rows().len() * study.sets.len();
     let n = 10_000usize.div_ceil(rows);
     bencher.bench(|| {
-        let (r, s) = run_ensembles(&study, n, &|| {});
+        let (r, s) = run_ensembles(&study, n, &|| {}).unwrap();
         divan::black_box((r.len(), s.len()))
     });
 }
@@ -39,5 +39,5 @@ fn facade_run_resting_early_stop(bencher: divan::Bencher, stop: bool) {
         atol: 1e-10,
         keep_history: false,
     };
-    bencher.bench(|| divan::black_box(run_with(&study.block, rec, &spec, stop).0.max_theta_over_alpha));
+    bencher.bench(|| divan::black_box(run_with(&study.block, rec, &spec, stop).unwrap().0.max_theta_over_alpha));
 }

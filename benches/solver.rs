@@ -5,8 +5,9 @@
 use std::path::Path;
 
 use rayon::prelude::*;
-use rocklab::ground_motion::{read, ReadOptions, Record};
+use rocklab::ground_motion::{ReadOptions, Record};
 use rocklab::ingest::block::BlockSpec;
+use rocklab::ingest::record::read;
 use rocklab::study::{run, RunSpec};
 
 fn main() {
@@ -44,7 +45,7 @@ fn facade_nrc_20161030_one_run(bencher: divan::Bencher) {
     let block = BlockSpec::load(&fixtures().join("facade/block.toml")).unwrap();
     let rec = record("IT.NRC..HGE.D.20161030.064018.C.ACC.ASC");
     let s = spec(0.59, 0.68, -1.0);
-    bencher.bench(|| divan::black_box(run(&block, &rec, &s).0.max_theta_over_alpha));
+    bencher.bench(|| divan::black_box(run(&block, &rec, &s).unwrap().0.max_theta_over_alpha));
 }
 
 #[divan::bench(sample_count = 20)]
@@ -66,5 +67,5 @@ fn facade_batch_3_records_2_sets_2_polarities(bencher: divan::Bencher) {
             }
         }
     }
-    bencher.bench(|| jobs.par_iter().map(|(r, s)| run(&block, r, s).0.impacts).sum::<usize>());
+    bencher.bench(|| jobs.par_iter().map(|(r, s)| run(&block, r, s).unwrap().0.impacts).sum::<usize>());
 }

@@ -13,11 +13,53 @@
 //!
 //! [`fit`]: crate::fit
 
-use crate::fit::{levenberg_marquardt, FitResult, FitStop};
-use crate::ingest::{Campaign, Rocking};
-use crate::reduce::{CampaignResult, Reduced};
+use crate::fit::{least_squares, FitError, FitResult, FitStop};
+use crate::reduction::Reduced;
 use crate::solver::{simulate_at, Ground, Restraint, RockingModel, Settings};
-use crate::wall::{p_squared_rectangular, slenderness};
+use crate::wall::{Rocking, Side, Wall};
+
+/// A reduced test as the calibration takes it (the input edge builds it from a
+/// reduced campaign: `rocklab::reduce::CampaignResult::calibration_input`).
+#[derive(Debug, Clone, Copy)]
+pub struct TestInput<'a> {
+    pub id: &'a str,
+    pub exclude_from_mean: bool,
+    /// Lever arm of the sensor about the hinge, m.
+    pub lever_arm_m: f64,
+    /// The reduction, or why there is none.
+    pub reduced: Result<&'a Reduced, &'a (dyn std::error::Error + Sync)>,
+}
+
+/// A reduced campaign as the calibration takes it.
+#[derive(Debug, Clone)]
+pub struct CampaignInput<'a> {
+    pub name: &'a str,
+    pub rocking: Rocking,
+    pub wall: Wall,
+    pub tests: Vec<TestInput<'a>>,
+}
+
+/// Why a test has no fit.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TestFailure {
+    /// The reduction failed (its message).
+    #[error("not reduced: {0}")]
+    NotReduced(String),
+    #[error("fewer than {needed} impacts")]
+    TooFewImpacts { needed: usize },
+    /// No starting point of the κ grid (e at 0.7) gives a replay.
+    #[error("the fit failed: no starting point replays the test (the release displacement minus the zero offset is beyond the sensor's lever arm)")]
+    NoStart,
+    #[error("the fit failed: {0}")]
+    Fit(#[from] FitError),
+}
+
+impl serde::Serialize for TestFailure {
+    /// As its message (summary.json: `"error": "…"`).
+    fn serialize<S: serde::Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
+        ser.collect_str(self)
+    }
+}
 
 /// The data of one test that the fit uses.
 #[derive(Debug, Clone)]
@@ -41,13 +83,84 @@ pub struct Geometry {
 }
 
 impl Geometry {
-    pub fn of(c: &Campaign) -> Geometry {
-        let h = c.height_m - c.hinge_height_m;
+    /// The rocking part above the hinge of a campaign's wall.
+    pub fn of(rocking: Rocking, wall: &Wall) -> Geometry {
+        let part = wall.rocking_part();
         Geometry {
-            alpha: slenderness(c.thickness_m, h),
-            p2: p_squared_rectangular(h, c.thickness_m),
-            one_sided: c.rocking == Rocking::OneSided,
+            alpha: part.slenderness(),
+            p2: part.p_squared(),
+            one_sided: rocking == Rocking::OneSided,
         }
+    }
+
+    /// How many nuisance parameters a test has: [δt, z (mm), ln(p² factor)] and,
+    /// one-sided, ln κ.
+    fn n_nuisance(&self) -> usize {
+        if self.one_sided {
+            4
+        } else {
+            3
+        }
+    }
+}
+
+/// The nuisance parameters of one test, as packed in a parameter vector:
+/// [δt (s), z (mm), ln(p² factor), ln κ (one-sided only)].
+#[derive(Debug, Clone, Copy)]
+pub struct Nuisance<'a>(pub &'a [f64]);
+
+impl Nuisance<'_> {
+    /// Offset of the release time, s.
+    pub fn release_offset_s(&self) -> f64 {
+        self.0[0]
+    }
+    /// Transducer zero offset z, mm.
+    pub fn zero_offset_mm(&self) -> f64 {
+        self.0[1]
+    }
+    /// ln of the factor on p².
+    pub fn ln_p2_factor(&self) -> f64 {
+        self.0[2]
+    }
+    /// κ = k/I_0 of the inward spring (s⁻²), one-sided only.
+    pub fn kappa(&self) -> Option<f64> {
+        self.0.get(3).map(|l| l.exp())
+    }
+}
+
+/// How a fit packs its parameter vector: the coefficients (e alone when one e
+/// holds both ways, else e_in, e_out), then each test's [`Nuisance`].
+#[derive(Debug, Clone, Copy)]
+struct Packing {
+    /// Number of coefficients: 1 or 2.
+    n_e: usize,
+    /// Nuisance parameters per test.
+    n_nuisance: usize,
+}
+
+impl Packing {
+    fn new(geom: &Geometry, single_e: bool) -> Packing {
+        Packing {
+            n_e: if single_e { 1 } else { 2 },
+            n_nuisance: geom.n_nuisance(),
+        }
+    }
+    /// (e_in, e_out).
+    fn coefficients(&self, q: &[f64]) -> (f64, f64) {
+        if self.n_e == 1 {
+            (q[0], q[0])
+        } else {
+            (q[0], q[1])
+        }
+    }
+    /// Index in q of e_in and of e_out (the same with one e).
+    fn coefficient_indices(&self) -> (usize, usize) {
+        (0, self.n_e - 1)
+    }
+    /// The nuisance of test k.
+    fn nuisance<'a>(&self, q: &'a [f64], k: usize) -> Nuisance<'a> {
+        let start = self.n_e + k * self.n_nuisance;
+        Nuisance(&q[start..start + self.n_nuisance])
     }
 }
 
@@ -78,35 +191,26 @@ pub fn window(id: &str, r: &Reduced, lever_mm: f64, n_impacts: usize) -> Option<
     })
 }
 
-/// Per-test nuisance parameters: [δt, z (mm), ln(p² factor), ln κ (one-sided)].
-fn n_nuisance(g: &Geometry) -> usize {
-    if g.one_sided {
-        4
-    } else {
-        3
-    }
-}
-
-/// Modelled readings of one test for coefficients (e_in, e_out) and nuisance q.
-pub fn replay(w: &TestWindow, g: &Geometry, e_in: f64, e_out: f64, q: &[f64]) -> Option<Vec<f64>> {
+/// Modelled readings of one test for coefficients (e_in, e_out) and nuisance
+/// parameters `nu`; None outside the model's domain (e ∉ (0, 1.5), or a release
+/// displacement beyond the lever arm).
+pub fn replay(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, nu: Nuisance) -> Option<Vec<f64>> {
     if !(e_in > 0.0 && e_in < 1.5 && e_out > 0.0 && e_out < 1.5) {
         return None;
     }
-    let (dt, z, lnf) = (q[0], q[1], q[2]);
-    let kappa = if g.one_sided { q[3].exp() } else { 0.0 };
+    let z = nu.zero_offset_mm();
     let s = (w.x_release_mm - z) / w.lever_mm;
     if s.is_nan() || s.abs() >= 1.0 {
         return None;
     }
     let theta0 = s.asin();
     let model = RockingModel {
-        alpha: g.alpha,
-        p2: g.p2 * lnf.exp(),
+        alpha: geom.alpha,
+        p2: geom.p2 * nu.ln_p2_factor().exp(),
         i0: 1.0,
-        restraint: if g.one_sided {
-            Restraint::Rotational { k_nm_per_rad: kappa }
-        } else {
-            Restraint::None
+        restraint: match nu.kappa() {
+            Some(kappa) if geom.one_sided => Restraint::Rotational { k_nm_per_rad: kappa },
+            _ => Restraint::None,
         },
         ties: Vec::new(),
         e_in,
@@ -122,7 +226,7 @@ pub fn replay(w: &TestWindow, g: &Geometry, e_in: f64, e_out: f64, q: &[f64]) ->
     let mut settings = Settings::new(w.t_end).with_tolerances(1e-10, 1e-13).without_history();
     settings.max_step = 0.05;
     settings.rest_speed = 1e-9;
-    let (_, th) = simulate_at(&model, &ground, w.release_s + dt, Some([theta0, 0.0]), &settings, &w.t);
+    let (_, th) = simulate_at(&model, &ground, w.release_s + nu.release_offset_s(), Some([theta0, 0.0]), &settings, &w.t).ok()?;
     Some(th.iter().map(|t| z + w.lever_mm * t.sin()).collect())
 }
 
@@ -151,51 +255,49 @@ pub struct TestFit {
     pub replay_mm: Vec<f64>,
 }
 
-fn start_nuisance(g: &Geometry) -> Vec<f64> {
+/// Starting nuisance: no offsets, p² as nominal, κ as given (one-sided).
+fn start_nuisance(geom: &Geometry, kappa: f64) -> Vec<f64> {
     let mut q = vec![0.0, 0.0, 0.0];
-    if g.one_sided {
-        q.push((12.0 * g.p2).ln());
+    if geom.one_sided {
+        q.push(kappa.ln());
     }
     q
 }
 
-fn steps_nuisance(g: &Geometry) -> Vec<f64> {
+/// Finite-difference steps of the nuisance parameters.
+fn steps_nuisance(geom: &Geometry) -> Vec<f64> {
     let mut s = vec![1e-6, 1e-5, 1e-7];
-    if g.one_sided {
+    if geom.one_sided {
         s.push(1e-6);
     }
     s
 }
 
+/// Residuals (measured − modelled) of the tests `ws` for a packed parameter vector.
+fn residuals(ws: &[&TestWindow], geom: &Geometry, pack: Packing, q: &[f64]) -> Option<Vec<f64>> {
+    let (ei, eo) = pack.coefficients(q);
+    let mut all = Vec::with_capacity(ws.iter().map(|w| w.x_mm.len()).sum());
+    for (k, w) in ws.iter().enumerate() {
+        let m = replay(w, geom, ei, eo, pack.nuisance(q, k))?;
+        all.extend(w.x_mm.iter().zip(&m).map(|(a, b)| a - b));
+    }
+    Some(all)
+}
+
 /// Fit one test: parameters [e_in, e_out | e, nuisance…].
-pub fn fit_test(w: &TestWindow, g: &Geometry, two_sided_single_e: bool) -> Option<TestFit> {
-    let ne = if two_sided_single_e { 1 } else { 2 };
-    let split = |q: &[f64]| -> (f64, f64) {
-        if ne == 1 {
-            (q[0], q[0])
-        } else {
-            (q[0], q[1])
-        }
-    };
-    let resid = |q: &[f64]| -> Option<Vec<f64>> {
-        let (ei, eo) = split(q);
-        let m = replay(w, g, ei, eo, &q[ne..])?;
-        Some(w.x_mm.iter().zip(&m).map(|(a, b)| a - b).collect())
-    };
+pub fn fit_test(w: &TestWindow, geom: &Geometry, two_sided_single_e: bool) -> Result<TestFit, TestFailure> {
+    let pack = Packing::new(geom, two_sided_single_e);
+    let resid = |q: &[f64]| residuals(&[w], geom, pack, q);
     // Start from a sensible κ (one-sided): a small grid on the spring, e at 0.7.
     let mut best: Option<(Vec<f64>, f64)> = None;
-    let kappas: Vec<f64> = if g.one_sided {
-        [3.0, 6.0, 12.0, 24.0, 48.0].iter().map(|k| k * g.p2).collect()
+    let kappas: Vec<f64> = if geom.one_sided {
+        [3.0, 6.0, 12.0, 24.0, 48.0].iter().map(|k| k * geom.p2).collect()
     } else {
         vec![0.0]
     };
     for k in kappas {
-        let mut q0 = vec![0.7; ne];
-        let mut nu = start_nuisance(g);
-        if g.one_sided {
-            nu[3] = k.ln();
-        }
-        q0.extend(nu);
+        let mut q0 = vec![0.7; pack.n_e];
+        q0.extend(start_nuisance(geom, k));
         if let Some(r) = resid(&q0) {
             let c: f64 = r.iter().map(|v| v * v).sum();
             if best.as_ref().is_none_or(|b| c < b.1) {
@@ -203,22 +305,27 @@ pub fn fit_test(w: &TestWindow, g: &Geometry, two_sided_single_e: bool) -> Optio
             }
         }
     }
-    let (q0, _) = best?;
-    let mut steps = vec![1e-7; ne];
-    steps.extend(steps_nuisance(g));
-    let res: FitResult = levenberg_marquardt(&q0, &steps, 80, &resid)?;
-    Some(summarise(w, g, &res, ne))
+    let (q0, _) = best.ok_or(TestFailure::NoStart)?;
+    let mut steps = vec![1e-7; pack.n_e];
+    steps.extend(steps_nuisance(geom));
+    let res: FitResult = least_squares(&q0, &steps, 80, &resid)?;
+    Ok(summarise(w, geom, &res, pack))
 }
 
-fn summarise(w: &TestWindow, g: &Geometry, res: &FitResult, ne: usize) -> TestFit {
-    let (ei, eo) = if ne == 1 { (res.q[0], res.q[0]) } else { (res.q[0], res.q[1]) };
-    let se = |i: usize| res.covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt());
-    let (se_in, se_out) = if ne == 1 { (se(0), se(0)) } else { (se(0), se(1)) };
-    let nu = &res.q[ne..];
+/// Standard error of parameter i (NaN without a covariance).
+fn standard_error(res: &FitResult, i: usize) -> f64 {
+    res.covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt())
+}
+
+fn summarise(w: &TestWindow, geom: &Geometry, res: &FitResult, pack: Packing) -> TestFit {
+    let (ei, eo) = pack.coefficients(&res.q);
+    let (i_in, i_out) = pack.coefficient_indices();
+    let (se_in, se_out) = (standard_error(res, i_in), standard_error(res, i_out));
+    let nu = pack.nuisance(&res.q, 0);
     let n = w.x_mm.len();
     let rms = (res.cost / n as f64).sqrt();
     let range = w.x_mm.iter().fold(f64::NEG_INFINITY, |m, v| m.max(*v)) - w.x_mm.iter().fold(f64::INFINITY, |m, v| m.min(*v));
-    let replay_mm = replay(w, g, ei, eo, nu).unwrap_or_default();
+    let replay_mm = replay(w, geom, ei, eo, nu).unwrap_or_default();
     TestFit {
         id: w.id.clone(),
         e_in: ei,
@@ -227,10 +334,10 @@ fn summarise(w: &TestWindow, g: &Geometry, res: &FitResult, ne: usize) -> TestFi
         se_e_out: se_out,
         ci95_e_in: [ei - 1.96 * se_in, ei + 1.96 * se_in],
         ci95_e_out: [eo - 1.96 * se_out, eo + 1.96 * se_out],
-        release_offset_s: nu[0],
-        zero_offset_mm: nu[1],
-        p2_factor: nu[2].exp(),
-        kappa_per_s2: g.one_sided.then(|| nu[3].exp()),
+        release_offset_s: nu.release_offset_s(),
+        zero_offset_mm: nu.zero_offset_mm(),
+        p2_factor: nu.ln_p2_factor().exp(),
+        kappa_per_s2: nu.kappa().filter(|_| geom.one_sided),
         rms_mm: rms,
         nrmse: rms / range.max(1e-12),
         iterations: res.iterations,
@@ -250,8 +357,8 @@ pub fn per_impact(r: &Reduced, n_impacts: usize) -> (Vec<f64>, Vec<f64>) {
         if let Some(after) = i.v_after_mm_s {
             let e = (after / i.v_before_mm_s).abs();
             match i.entering {
-                crate::peaks::Side::Inward => inward.push(e),
-                crate::peaks::Side::Outward => outward.push(e),
+                Side::Inward => inward.push(e),
+                Side::Outward => outward.push(e),
             }
         }
     }
@@ -271,48 +378,34 @@ pub struct JointFit {
     pub tests: Vec<String>,
 }
 
-pub fn fit_joint(ws: &[TestWindow], g: &Geometry, starts: &[TestFit], single_e: bool) -> Option<JointFit> {
-    let ne = if single_e { 1 } else { 2 };
-    let nn = n_nuisance(g);
+/// The joint fit: shared e (or e_in, e_out) and each test's nuisance, started
+/// from the mean of the per-test fits `starts` and their nuisance.
+pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_e: bool) -> Result<JointFit, FitError> {
+    let pack = Packing::new(geom, single_e);
+    let mean = |f: fn(&TestFit) -> f64| starts.iter().map(f).sum::<f64>() / starts.len() as f64;
     let mut q0 = if single_e {
-        vec![starts.iter().map(|s| s.e_in).sum::<f64>() / starts.len() as f64]
+        vec![mean(|s| s.e_in)]
     } else {
-        vec![
-            starts.iter().map(|s| s.e_in).sum::<f64>() / starts.len() as f64,
-            starts.iter().map(|s| s.e_out).sum::<f64>() / starts.len() as f64,
-        ]
+        vec![mean(|s| s.e_in), mean(|s| s.e_out)]
     };
-    let mut steps = vec![1e-7; ne];
+    let mut steps = vec![1e-7; pack.n_e];
     for s in starts {
         q0.extend([s.release_offset_s, s.zero_offset_mm, s.p2_factor.ln()]);
-        if g.one_sided {
-            q0.push(s.kappa_per_s2.unwrap_or(12.0 * g.p2).ln());
+        if geom.one_sided {
+            q0.push(s.kappa_per_s2.unwrap_or(12.0 * geom.p2).ln());
         }
-        steps.extend(steps_nuisance(g));
+        steps.extend(steps_nuisance(geom));
     }
-    let resid = |q: &[f64]| -> Option<Vec<f64>> {
-        let (ei, eo) = if single_e { (q[0], q[0]) } else { (q[0], q[1]) };
-        let mut all = Vec::new();
-        for (k, w) in ws.iter().enumerate() {
-            let nu = &q[ne + k * nn..ne + (k + 1) * nn];
-            let m = replay(w, g, ei, eo, nu)?;
-            all.extend(w.x_mm.iter().zip(&m).map(|(a, b)| a - b));
-        }
-        Some(all)
-    };
-    let res = levenberg_marquardt(&q0, &steps, 40, &resid)?;
-    let se = |i: usize| res.covariance.as_ref().map_or(f64::NAN, |c| c[(i, i)].max(0.0).sqrt());
+    let refs: Vec<&TestWindow> = ws.iter().collect();
+    let res = least_squares(&q0, &steps, 40, &|q: &[f64]| residuals(&refs, geom, pack, q))?;
     let n: usize = ws.iter().map(|w| w.t.len()).sum();
-    let (ei, eo, si, so) = if single_e {
-        (res.q[0], res.q[0], se(0), se(0))
-    } else {
-        (res.q[0], res.q[1], se(0), se(1))
-    };
-    Some(JointFit {
+    let (ei, eo) = pack.coefficients(&res.q);
+    let (i_in, i_out) = pack.coefficient_indices();
+    Ok(JointFit {
         e_in: ei,
         e_out: eo,
-        se_e_in: si,
-        se_e_out: so,
+        se_e_in: standard_error(&res, i_in),
+        se_e_out: standard_error(&res, i_out),
         rms_mm: (res.cost / n as f64).sqrt(),
         iterations: res.iterations,
         stop: res.stop,
@@ -324,7 +417,7 @@ pub fn fit_joint(ws: &[TestWindow], g: &Geometry, starts: &[TestFit], single_e: 
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Calibration {
     pub campaign: String,
-    pub rocking: String,
+    pub rocking: Rocking,
     pub e_housner: f64,
     /// Means over the included tests (the values written as the calibration).
     pub e_in: f64,
@@ -332,72 +425,86 @@ pub struct Calibration {
     pub r_in: f64,
     pub r_out: f64,
     pub joint: Option<JointFit>,
+    /// Why there is no joint fit, when there are included tests but no joint fit.
+    #[serde(skip)]
+    pub joint_failure: Option<FitError>,
     pub tests: Vec<TestFit>,
     /// Per-impact coefficients from the data, per test: (id, inward, outward).
     pub per_impact: Vec<(String, Vec<f64>, Vec<f64>)>,
     pub included: Vec<String>,
-    pub failed: Vec<(String, String)>,
+    pub failed: Vec<(String, TestFailure)>,
 }
 
-/// (id, excluded from the mean, window and fit or why not, per-impact coefficients)
-type TestOutcome = (String, bool, Result<(TestWindow, TestFit), String>, Option<(Vec<f64>, Vec<f64>)>);
+/// What calibrating one test gave.
+struct TestCalibration {
+    id: String,
+    exclude_from_mean: bool,
+    fit: Result<(TestWindow, TestFit), TestFailure>,
+    /// Per-impact coefficients (inward, outward), when the test was reduced.
+    per_impact: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+/// Window and fit one reduced test.
+fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usize) -> TestCalibration {
+    let (fit, per_impact) = match t.reduced {
+        Err(e) => (Err(TestFailure::NotReduced(e.to_string())), None),
+        Ok(r) => {
+            let fit = window(t.id, r, t.lever_arm_m * 1e3, n_impacts)
+                .ok_or(TestFailure::TooFewImpacts { needed: n_impacts })
+                .and_then(|w| fit_test(&w, geom, single_e).map(|f| (w, f)));
+            (fit, Some(per_impact(r, n_impacts)))
+        }
+    };
+    TestCalibration {
+        id: t.id.to_string(),
+        exclude_from_mean: t.exclude_from_mean,
+        fit,
+        per_impact,
+    }
+}
 
 /// Calibrate a reduced campaign (tests in parallel).
-pub fn calibrate(res: &CampaignResult, n_impacts: usize) -> Calibration {
+pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
     use rayon::prelude::*;
-    let c = &res.campaign;
-    let g = Geometry::of(c);
+    let geom = Geometry::of(c.rocking, &c.wall);
     let single_e = c.rocking == Rocking::TwoSided;
-    let outcomes: Vec<TestOutcome> = res
-        .tests
-        .par_iter()
-        .map(|t| {
-            let id = t.spec.id.clone();
-            let r = match &t.result {
-                Ok(r) => r,
-                Err(e) => return (id, t.spec.exclude_from_mean, Err(format!("not reduced: {e}")), None),
-            };
-            let pi = per_impact(r, n_impacts);
-            let out = window(&id, r, t.spec.lever_arm_m * 1e3, n_impacts)
-                .ok_or_else(|| format!("fewer than {n_impacts} impacts"))
-                .and_then(|w| fit_test(&w, &g, single_e).map(|f| (w, f)).ok_or_else(|| "the fit failed".to_string()));
-            (id, t.spec.exclude_from_mean, out, Some(pi))
-        })
-        .collect();
+    let outcomes: Vec<TestCalibration> = c.tests.par_iter().map(|t| calibrate_test(t, &geom, single_e, n_impacts)).collect();
     let mut tests = Vec::new();
     let mut windows = Vec::new();
     let mut included = Vec::new();
     let mut failed = Vec::new();
     let mut per = Vec::new();
     let mut inc_fits = Vec::new();
-    for (id, excl, out, pi) in outcomes {
-        if let Some((a, b)) = pi {
-            per.push((id.clone(), a, b));
+    for o in outcomes {
+        if let Some((a, b)) = o.per_impact {
+            per.push((o.id.clone(), a, b));
         }
-        match out {
+        match o.fit {
             Ok((w, f)) => {
-                if !excl {
-                    included.push(id.clone());
+                if !o.exclude_from_mean {
+                    included.push(o.id.clone());
                     windows.push(w);
                     inc_fits.push(f.clone());
                 }
                 tests.push(f);
             }
-            Err(e) => failed.push((id, e)),
+            Err(e) => failed.push((o.id, e)),
         }
     }
     let mean = |f: fn(&TestFit) -> f64| inc_fits.iter().map(f).sum::<f64>() / inc_fits.len().max(1) as f64;
     let (e_in, e_out) = (mean(|t| t.e_in), mean(|t| t.e_out));
-    let joint = (!windows.is_empty()).then(|| fit_joint(&windows, &g, &inc_fits, single_e)).flatten();
+    let joint = (!windows.is_empty()).then(|| fit_joint(&windows, &geom, &inc_fits, single_e));
+    let e_housner = c.wall.e_housner;
     Calibration {
-        campaign: c.name.clone(),
-        rocking: c.rocking.as_str().into(),
-        e_housner: c.e_housner,
+        campaign: c.name.to_string(),
+        rocking: c.rocking,
+        e_housner,
         e_in,
         e_out,
-        r_in: e_in / c.e_housner,
-        r_out: e_out / c.e_housner,
-        joint,
+        r_in: e_in / e_housner,
+        r_out: e_out / e_housner,
+        joint_failure: joint.clone().and_then(Result::err),
+        joint: joint.and_then(Result::ok),
         tests,
         per_impact: per,
         included,
@@ -407,7 +514,7 @@ pub fn calibrate(res: &CampaignResult, n_impacts: usize) -> Calibration {
 
 /// What an uncertainty ensemble needs from a calibration: the spread of the
 /// per-test fits over the included tests and the fits' own standard errors.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Spread {
     pub n_tests: usize,
     /// Test-to-test sample standard deviation (n − 1) of the per-test e_in, e_out
@@ -450,38 +557,156 @@ pub fn spread(c: &Calibration) -> Spread {
     }
 }
 
-/// calibration.toml (read by `simulate --calibration` and the façade study):
-/// the means, the spread an ensemble draws from (`[calibration.spread]`) and the
-/// joint fit.
-pub fn to_toml(c: &Calibration) -> String {
-    let mut s = format!(
-        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from); [calibration.joint]:\n# one fit over all of them.\n[calibration]\ncampaign = {:?}\nrocking = {:?}\ne_in = {}\ne_out = {}\nr_in = {}\nr_out = {}\ne_housner = {}\n",
-        c.included.join(", "),
-        c.campaign,
-        c.rocking,
-        c.e_in,
-        c.e_out,
-        c.r_in,
-        c.r_out,
-        c.e_housner
-    );
-    let sp = spread(c);
-    s.push_str(&format!(
-        "\n[calibration.spread]\n# Each test: unweighted least squares on the displacement (mm) over the window of\n# its first impacts, nuisance parameters free (release time, zero, p² factor{}).\nweighting = \"unweighted least squares on displacement, per test\"\nn_tests = {}\nsd_e_in_tests = {}\nsd_e_out_tests = {}\nse_e_in_mean = {}\nse_e_out_mean = {}\nse_e_in_fit = {}\nse_e_out_fit = {}\n",
-        if c.rocking == "one-sided" { ", inward spring" } else { "" },
-        sp.n_tests,
-        sp.sd_e_in_tests,
-        sp.sd_e_out_tests,
-        sp.se_e_in_mean,
-        sp.se_e_out_mean,
-        sp.se_e_in_fit,
-        sp.se_e_out_fit
-    ));
-    if let Some(j) = &c.joint {
-        s.push_str(&format!(
-            "\n[calibration.joint]\ne_in = {}\ne_out = {}\nse_e_in = {}\nse_e_out = {}\nrms_mm = {}\n",
-            j.e_in, j.e_out, j.se_e_in, j.se_e_out, j.rms_mm
-        ));
+/// calibration.toml: written by `rocklab calibrate` ([`to_toml`]), read by
+/// `simulate --calibration` and the façade study (`rocklab::ingest::calibration`):
+/// one type for the writer and the readers.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CalibrationFile {
+    pub calibration: CalibrationValues,
+}
+
+/// The `[calibration]` table: the means of the per-test fits over the included
+/// tests, the spread an ensemble draws from and the joint fit. Only e_in and e_out
+/// are required of a file.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CalibrationValues {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub campaign: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rocking: Option<Rocking>,
+    pub e_in: f64,
+    pub e_out: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub r_in: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub r_out: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub e_housner: Option<f64>,
+    /// `[calibration.spread]` (absent in files written before it was added).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spread: Option<SpreadTable>,
+    /// `[calibration.joint]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub joint: Option<JointValues>,
+}
+
+/// `[calibration.spread]`: how the per-test fits were weighted, and their spread.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SpreadTable {
+    pub weighting: String,
+    #[serde(flatten)]
+    pub spread: Spread,
+}
+
+/// `[calibration.joint]`: the joint fit's values.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct JointValues {
+    pub e_in: f64,
+    pub e_out: f64,
+    pub se_e_in: f64,
+    pub se_e_out: f64,
+    pub rms_mm: f64,
+}
+
+impl CalibrationFile {
+    /// The file of a calibration.
+    pub fn of(c: &Calibration) -> CalibrationFile {
+        CalibrationFile {
+            calibration: CalibrationValues {
+                campaign: Some(c.campaign.clone()),
+                rocking: Some(c.rocking),
+                e_in: c.e_in,
+                e_out: c.e_out,
+                r_in: Some(c.r_in),
+                r_out: Some(c.r_out),
+                e_housner: Some(c.e_housner),
+                spread: Some(SpreadTable {
+                    weighting: "unweighted least squares on displacement, per test".into(),
+                    spread: spread(c),
+                }),
+                joint: c.joint.as_ref().map(|j| JointValues {
+                    e_in: j.e_in,
+                    e_out: j.e_out,
+                    se_e_in: j.se_e_in,
+                    se_e_out: j.se_e_out,
+                    rms_mm: j.rms_mm,
+                }),
+            },
+        }
     }
-    s
+}
+
+/// calibration.toml of a calibration: a comment saying what the values are, then
+/// [`CalibrationFile`].
+pub fn to_toml(c: &Calibration) -> Result<String, toml::ser::Error> {
+    let header = format!(
+        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them.\n",
+        c.included.join(", "),
+        if c.rocking == Rocking::OneSided { ", inward spring" } else { "" },
+    );
+    Ok(header + &toml::to_string(&CalibrationFile::of(c))?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wall::Provenance;
+
+    fn wall() -> Wall {
+        Wall {
+            height_m: 2.70,
+            thickness_m: 0.36,
+            hinge_height_m: 0.23,
+            alpha_rad: 0.133,
+            alpha_source: Provenance::Computed("test".into()),
+            e_housner: 0.974,
+            e_housner_source: Provenance::Computed("test".into()),
+        }
+    }
+
+    /// A window whose release lies beyond the lever arm cannot be replayed from
+    /// any start: the failure says so (it used to be "the fit failed").
+    #[test]
+    fn a_window_that_cannot_be_replayed_says_why() {
+        let geom = Geometry::of(Rocking::OneSided, &wall());
+        let w = TestWindow {
+            id: "x".into(),
+            t: (0..100).map(|i| 1.0 + i as f64 * 0.01).collect(),
+            x_mm: vec![0.0; 100],
+            release_s: 1.0,
+            x_release_mm: 3000.0,
+            lever_mm: 2330.0,
+            t_end: 2.0,
+        };
+        let e = fit_test(&w, &geom, false).unwrap_err();
+        assert_eq!(e, TestFailure::NoStart);
+        assert!(e.to_string().starts_with("the fit failed: no starting point"), "{e}");
+    }
+
+    /// A test that was not reduced is listed as failed with the reduction's reason.
+    #[test]
+    fn a_test_not_reduced_is_failed_with_its_reason() {
+        let err = std::io::Error::other("x.csv: file not found");
+        let input = CampaignInput {
+            name: "c",
+            rocking: Rocking::TwoSided,
+            wall: wall(),
+            tests: vec![TestInput {
+                id: "a",
+                exclude_from_mean: false,
+                lever_arm_m: 2.33,
+                reduced: Err(&err),
+            }],
+        };
+        let cal = calibrate(&input, 6);
+        assert_eq!(
+            cal.failed,
+            vec![("a".to_string(), TestFailure::NotReduced("x.csv: file not found".into()))]
+        );
+        assert_eq!(
+            serde_json::to_value(&cal.failed[0].1).unwrap(),
+            serde_json::json!("not reduced: x.csv: file not found")
+        );
+        assert!(cal.joint.is_none() && cal.tests.is_empty());
+    }
 }

@@ -148,6 +148,16 @@ pub enum CoefficientDist {
     Pair { e_in: Dist, e_out: Dist },
 }
 
+impl CoefficientDist {
+    /// Whether a sample draws e (a spread on either coefficient).
+    pub fn is_random(&self) -> bool {
+        match self {
+            CoefficientDist::Single(d) => d.is_random(),
+            CoefficientDist::Pair { e_in, e_out } => e_in.is_random() || e_out.is_random(),
+        }
+    }
+}
+
 /// Nominal values the shared draws replace.
 #[derive(Debug, Clone, Copy)]
 pub struct Nominal {

@@ -30,3 +30,197 @@ pub enum InputError {
     #[error("{file}: {message}")]
     File { file: PathBuf, message: String },
 }
+
+impl InputError {
+    /// The file at fault.
+    pub fn file(&self) -> &std::path::Path {
+        match self {
+            InputError::Io { file, .. }
+            | InputError::Missing { file }
+            | InputError::Empty { file }
+            | InputError::NoData { file, .. }
+            | InputError::At { file, .. }
+            | InputError::Line { file, .. }
+            | InputError::File { file, .. } => file,
+        }
+    }
+}
+
+/// Which TOML input a [`FileError`] is about (named in its message).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    Manifest,
+    Block,
+    Study,
+    Calibration,
+}
+
+impl std::fmt::Display for FileKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            FileKind::Manifest => "manifest",
+            FileKind::Block => "block file",
+            FileKind::Study => "study",
+            FileKind::Calibration => "calibration",
+        })
+    }
+}
+
+/// A defect in a TOML input (campaign manifest, block file, study, calibration):
+/// every variant names the file; a parse error also its line and column.
+#[derive(Debug, thiserror::Error)]
+pub enum FileError {
+    #[error("{}: {kind} not found", file.display())]
+    NotFound { file: PathBuf, kind: FileKind },
+    #[error("{}: cannot read {kind}: {source}", file.display())]
+    Io {
+        file: PathBuf,
+        kind: FileKind,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not TOML, an unknown key, a missing key or a wrong type (the parser's
+    /// message, which shows the line).
+    #[error("{}: {message}", file.display())]
+    Toml {
+        file: PathBuf,
+        /// 1-based line and column of the defect, when the parser located it.
+        line: Option<usize>,
+        column: Option<usize>,
+        message: String,
+    },
+    /// A value out of its range or a combination that does not go together; the
+    /// message names the table and key, and the line and column of the key are
+    /// given when the text shows it in one place.
+    #[error("{}: {message}", place(.file, *.line, *.column))]
+    Invalid {
+        file: PathBuf,
+        line: Option<usize>,
+        column: Option<usize>,
+        message: String,
+    },
+    /// A file that this one refers to (a study's block, record or calibration).
+    #[error(transparent)]
+    Input(#[from] InputError),
+}
+
+/// "file:line:column", or "file" when the place is not known.
+fn place(file: &std::path::Path, line: Option<usize>, column: Option<usize>) -> String {
+    match (line, column) {
+        (Some(l), Some(c)) => format!("{}:{l}:{c}", file.display()),
+        _ => file.display().to_string(),
+    }
+}
+
+impl FileError {
+    /// An invalid value of `file` (not yet located: see [`FileError::located`]).
+    pub fn invalid(file: &std::path::Path, message: impl std::fmt::Display) -> FileError {
+        FileError::Invalid {
+            file: file.to_path_buf(),
+            line: None,
+            column: None,
+            message: message.to_string(),
+        }
+    }
+
+    /// An [`FileError::Invalid`] located in the TOML `text` it was found in: the
+    /// key its message starts with (`[table].key = …`, `key = …`, or
+    /// `[[table]] id = "x": …` / `[[table]] "x": …` for an entry), when that key
+    /// stands on exactly one line of the text. Other errors are returned as they are.
+    /// Only an error of `path` itself is located (not one of a file it names).
+    pub fn located(self, path: &std::path::Path, text: &str) -> FileError {
+        match self {
+            FileError::Invalid {
+                file,
+                line: None,
+                column: None,
+                message,
+            } if file == path => {
+                let (line, column) = locate(text, &message).unzip();
+                FileError::Invalid { file, line, column, message }
+            }
+            other => other,
+        }
+    }
+}
+
+/// Where the key an error message starts with stands in a TOML text (1-based line
+/// and column), if on exactly one line.
+fn locate(text: &str, message: &str) -> Option<(usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    // The line range of a table's body: after its header, up to the next header.
+    let section = |table: &str| -> Option<(usize, usize)> {
+        let start = lines.iter().position(|l| l.trim() == format!("[{table}]"))? + 1;
+        let end = lines[start..]
+            .iter()
+            .position(|l| l.trim_start().starts_with('['))
+            .map_or(lines.len(), |k| start + k);
+        Some((start, end))
+    };
+    let (range, needle) = if let Some(rest) = message.strip_prefix("[[") {
+        // An entry of an array of tables, named by its id or name value.
+        let value = rest.split_once("]] ")?.1;
+        let value = value.strip_prefix("id = ").unwrap_or(value);
+        let quoted = value.split_once(": ").map_or(value, |(v, _)| v);
+        ((0, lines.len()), quoted.to_string())
+    } else if let Some(rest) = message.strip_prefix('[') {
+        let (table, rest) = rest.split_once("].")?;
+        let key: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        (section(table)?, key)
+    } else {
+        let key: String = message.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        ((0, lines.len()), key)
+    };
+    if needle.is_empty() {
+        return None;
+    }
+    let is_key_line = |l: &str| {
+        let l = l.trim_start();
+        if needle.starts_with('"') {
+            // `name = "x"` or `id = "x"` of an entry.
+            l.split_once('=').is_some_and(|(_, v)| v.trim() == needle)
+        } else {
+            l.strip_prefix(needle.as_str()).is_some_and(|r| r.trim_start().starts_with('='))
+        }
+    };
+    let hits: Vec<usize> = (range.0..range.1).filter(|&i| is_key_line(lines[i])).collect();
+    match hits.as_slice() {
+        [i] => {
+            let l = lines[*i];
+            let indent = l.chars().count() - l.trim_start().chars().count();
+            Some((i + 1, indent + 1))
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "[campaign]\nname = \"c\"\n[wall]\nheight_m = 2.7\n  thickness_m = -0.36\n[[test]]\nid = \"a\"\n[[test]]\nid = \"b\"\n";
+
+    fn at(message: &str) -> (Option<usize>, Option<usize>) {
+        let m = std::path::Path::new("m.toml");
+        match FileError::invalid(m, message).located(m, TEXT) {
+            FileError::Invalid { line, column, .. } => (line, column),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_validation_error_names_the_line_and_column_of_its_key() {
+        assert_eq!(at("[wall].thickness_m = -0.36: expected a positive number"), (Some(5), Some(3)));
+        assert_eq!(at("[[test]] id = \"b\": duplicate test id"), (Some(9), Some(1)));
+        assert_eq!(at("height_m = 0: expected a positive number"), (Some(4), Some(1)));
+        // Not in the text, or in more than one place: no place rather than a wrong one.
+        assert_eq!(at("[wall].alpha_rad = 2: expected 0 < α < π/2"), (None, None));
+        assert_eq!(at("no [[test]] entries"), (None, None));
+        let m = std::path::Path::new("m.toml");
+        let e = FileError::invalid(m, "[wall].thickness_m = -0.36: expected a positive number").located(m, TEXT);
+        assert_eq!(e.to_string(), "m.toml:5:3: [wall].thickness_m = -0.36: expected a positive number");
+        // An error of another file (a study's block file) is left alone.
+        let other = FileError::invalid(std::path::Path::new("block.toml"), "[wall].thickness_m = 1").located(m, TEXT);
+        assert_eq!(other.to_string(), "block.toml: [wall].thickness_m = 1");
+    }
+}

@@ -18,6 +18,18 @@ pub enum FitStop {
     Stalled,
 }
 
+/// Why there is no fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum FitError {
+    /// The residual function is undefined at the starting point (a replay outside
+    /// the model's domain).
+    #[error("the residuals are undefined at the starting point")]
+    UndefinedStart,
+    /// Fewer residuals than parameters: the data cannot determine them.
+    #[error("{residuals} residuals for {parameters} parameters: expected at least as many residuals")]
+    Underdetermined { residuals: usize, parameters: usize },
+}
+
 /// Result of a fit.
 #[derive(Debug, Clone)]
 pub struct FitResult {
@@ -32,94 +44,139 @@ pub struct FitResult {
     pub covariance: Option<DMatrix<f64>>,
 }
 
-/// Finite-difference steps: `steps[j]` absolute step of parameter j.
-pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync)) -> Option<FitResult> {
-    let mut q = q0.to_vec();
-    let mut r = residuals(&q)?;
-    let n = r.len();
-    let np = q.len();
-    let mut cost: f64 = r.iter().map(|v| v * v).sum();
-    let mut mu = 1e-3;
+/// Residuals of a parameter vector, None where they are undefined.
+pub type Residuals<'a> = dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync + 'a;
+
+/// As [`least_squares`], None instead of the reason (for callers that only need to
+/// know whether there is a fit, e.g. the estimator's arc fits).
+pub fn levenberg_marquardt(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &Residuals) -> Option<FitResult> {
+    least_squares(q0, steps, max_iter, residuals).ok()
+}
+
+/// Forward-difference Jacobian of the residuals `r` at `q` (columns in parallel);
+/// a backward difference where the forward point is undefined, zeros where both are.
+fn jacobian(residuals: &Residuals, steps: &[f64], q: &[f64], r: &[f64]) -> DMatrix<f64> {
+    use rayon::prelude::*;
+    let (n, np) = (r.len(), q.len());
+    let cols: Vec<Vec<f64>> = (0..np)
+        .into_par_iter()
+        .map(|j| {
+            let mut qj = q.to_vec();
+            qj[j] += steps[j];
+            match residuals(&qj) {
+                Some(rp) => rp.iter().zip(r).map(|(a, b)| (a - b) / steps[j]).collect(),
+                None => {
+                    qj[j] -= 2.0 * steps[j];
+                    residuals(&qj).map_or(vec![0.0; n], |rm| r.iter().zip(&rm).map(|(a, b)| (a - b) / steps[j]).collect())
+                }
+            }
+        })
+        .collect();
+    DMatrix::from_fn(n, np, |i, j| cols[j][i])
+}
+
+/// The point of a fit: parameters, residuals, cost, damping.
+struct Point {
+    q: Vec<f64>,
+    r: Vec<f64>,
+    cost: f64,
+    mu: f64,
+}
+
+/// What one Levenberg–Marquardt iteration did.
+enum Iteration {
+    /// A step decreased the cost by the relative amount `rel`; `small` when the
+    /// step was below 1e-10 relative.
+    Accepted { rel: f64, small: bool },
+    /// No damping (16 tries, ×10 each) decreased the cost.
+    NoDecrease,
+}
+
+/// One iteration: solve (JᵀJ + μ diag JᵀJ) δ = Jᵀr with μ raised until the cost
+/// decreases; then μ is lowered.
+fn iterate(p: &mut Point, jac: &DMatrix<f64>, residuals: &Residuals) -> Iteration {
+    let np = p.q.len();
+    let rv = DVector::from_column_slice(&p.r);
+    let jtj = jac.tr_mul(jac);
+    let jtr = jac.tr_mul(&rv);
+    for _ in 0..16 {
+        let mut a = jtj.clone();
+        for j in 0..np {
+            a[(j, j)] += p.mu * jtj[(j, j)].max(1e-300);
+        }
+        let Some(step) = a.cholesky().map(|c| c.solve(&jtr)) else {
+            p.mu *= 10.0;
+            continue;
+        };
+        let trial: Vec<f64> = p.q.iter().zip(step.iter()).map(|(a, b)| a - b).collect();
+        if let Some(rt) = residuals(&trial) {
+            let ct: f64 = rt.iter().map(|v| v * v).sum();
+            if ct < p.cost {
+                let rel = (p.cost - ct) / p.cost.max(1e-300);
+                let small = step.iter().zip(&p.q).all(|(s, v)| s.abs() <= 1e-10 * v.abs().max(1e-6));
+                p.q = trial;
+                p.r = rt;
+                p.cost = ct;
+                p.mu = (p.mu / 3.0).max(1e-15);
+                return Iteration::Accepted { rel, small };
+            }
+        }
+        p.mu *= 10.0;
+    }
+    Iteration::NoDecrease
+}
+
+/// Minimise the sum of squared `residuals` from `q0` by Levenberg–Marquardt;
+/// finite-difference steps: `steps[j]` absolute step of parameter j.
+pub fn least_squares(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &Residuals) -> Result<FitResult, FitError> {
+    let r = residuals(q0).ok_or(FitError::UndefinedStart)?;
+    let (n, np) = (r.len(), q0.len());
+    if n < np {
+        return Err(FitError::Underdetermined {
+            residuals: n,
+            parameters: np,
+        });
+    }
+    let cost: f64 = r.iter().map(|v| v * v).sum();
+    let mut p = Point {
+        q: q0.to_vec(),
+        r,
+        cost,
+        mu: 1e-3,
+    };
     let mut stop = FitStop::MaxIterations;
     let mut iterations = 0;
     let mut last_rel = f64::INFINITY;
-    let jacobian = |q: &[f64], r: &[f64]| -> DMatrix<f64> {
-        let cols: Vec<Vec<f64>> = {
-            use rayon::prelude::*;
-            (0..np)
-                .into_par_iter()
-                .map(|j| {
-                    let mut qj = q.to_vec();
-                    qj[j] += steps[j];
-                    match residuals(&qj) {
-                        Some(rp) => rp.iter().zip(r).map(|(a, b)| (a - b) / steps[j]).collect(),
-                        None => {
-                            qj[j] -= 2.0 * steps[j];
-                            residuals(&qj).map_or(vec![0.0; n], |rm| r.iter().zip(&rm).map(|(a, b)| (a - b) / steps[j]).collect())
-                        }
-                    }
-                })
-                .collect()
-        };
-        DMatrix::from_fn(n, np, |i, j| cols[j][i])
-    };
     for it in 0..max_iter {
         iterations = it + 1;
-        let jac = jacobian(&q, &r);
-        let rv = DVector::from_column_slice(&r);
-        let jtj = jac.tr_mul(&jac);
-        let jtr = jac.tr_mul(&rv);
-        let mut improved = false;
-        for _ in 0..16 {
-            let mut a = jtj.clone();
-            for j in 0..np {
-                a[(j, j)] += mu * jtj[(j, j)].max(1e-300);
-            }
-            let Some(step) = a.cholesky().map(|c| c.solve(&jtr)) else {
-                mu *= 10.0;
-                continue;
-            };
-            let trial: Vec<f64> = q.iter().zip(step.iter()).map(|(a, b)| a - b).collect();
-            if let Some(rt) = residuals(&trial) {
-                let ct: f64 = rt.iter().map(|v| v * v).sum();
-                if ct < cost {
-                    let rel = (cost - ct) / cost.max(1e-300);
-                    last_rel = rel;
-                    let small_step = step.iter().zip(&q).all(|(s, v)| s.abs() <= 1e-10 * v.abs().max(1e-6));
-                    q = trial;
-                    r = rt;
-                    cost = ct;
-                    mu = (mu / 3.0).max(1e-15);
-                    improved = true;
-                    if rel < 1e-12 || small_step {
-                        stop = FitStop::Converged;
-                    }
+        let jac = jacobian(residuals, steps, &p.q, &p.r);
+        match iterate(&mut p, &jac, residuals) {
+            Iteration::Accepted { rel, small } => {
+                last_rel = rel;
+                if rel < 1e-12 || small {
+                    stop = FitStop::Converged;
                     break;
                 }
             }
-            mu *= 10.0;
-        }
-        if !improved {
-            // Nothing decreases the cost: at a minimum to working precision (the
-            // last accepted step gained < 1e-8), or stuck.
-            stop = if mu > 1e10 || last_rel < 1e-8 {
-                FitStop::Converged
-            } else {
-                FitStop::Stalled
-            };
-            break;
-        }
-        if stop == FitStop::Converged {
-            break;
+            Iteration::NoDecrease => {
+                // Nothing decreases the cost: at a minimum to working precision (the
+                // last accepted step gained < 1e-8), or stuck.
+                stop = if p.mu > 1e10 || last_rel < 1e-8 {
+                    FitStop::Converged
+                } else {
+                    FitStop::Stalled
+                };
+                break;
+            }
         }
     }
-    let jac = jacobian(&q, &r);
+    let jac = jacobian(residuals, steps, &p.q, &p.r);
     let dof = n.saturating_sub(np).max(1) as f64;
-    let covariance = covariance(jac.tr_mul(&jac)).map(|m| m * (cost / dof));
-    Some(FitResult {
-        q,
-        cost,
-        residuals: r,
+    let covariance = covariance(jac.tr_mul(&jac)).map(|m| m * (p.cost / dof));
+    Ok(FitResult {
+        q: p.q,
+        cost: p.cost,
+        residuals: p.r,
         iterations,
         stop,
         covariance,
@@ -156,5 +213,18 @@ mod tests {
             res.stop
         );
         assert_eq!(res.stop, FitStop::Converged);
+    }
+
+    /// A fit that cannot start says why (it used to be a bare None).
+    #[test]
+    fn a_failed_fit_says_why() {
+        let undefined = |_: &[f64]| None;
+        assert_eq!(least_squares(&[1.0], &[1e-7], 10, &undefined).unwrap_err(), FitError::UndefinedStart);
+        let one = |q: &[f64]| Some(vec![q[0] - 1.0]);
+        assert_eq!(
+            least_squares(&[0.0, 0.0], &[1e-7, 1e-7], 10, &one).unwrap_err(),
+            FitError::Underdetermined { residuals: 1, parameters: 2 }
+        );
+        assert!(levenberg_marquardt(&[1.0], &[1e-7], 10, &undefined).is_none());
     }
 }

@@ -93,7 +93,7 @@ fn log_likelihood(trials: &[Trial], a: f64, b: f64) -> f64 {
 /// λ₀ = φ/(1 − Φ(η)): ∂ℓ/∂η = k λ₁ − (n − k) λ₀ and
 /// ∂²ℓ/∂η² = −k λ₁(η + λ₁) − (n − k) λ₀(λ₀ − η).
 fn derivatives(trials: &[Trial], a: f64, b: f64) -> ([f64; 2], [[f64; 3]; 1]) {
-    let (mut g, mut h) = ([0.0; 2], [0.0; 3]);
+    let (mut grad, mut h) = ([0.0; 2], [0.0; 3]);
     for t in trials {
         let x = t.im.ln();
         let eta = (a + b * x).clamp(-35.0, 35.0);
@@ -103,19 +103,18 @@ fn derivatives(trials: &[Trial], a: f64, b: f64) -> ([f64; 2], [[f64; 3]; 1]) {
         let (k, m) = (t.k as f64, (t.n - t.k) as f64);
         let d1 = k * l1 - m * l0;
         let d2 = -k * l1 * (eta + l1) - m * l0 * (l0 - eta);
-        g[0] += d1;
-        g[1] += d1 * x;
+        grad[0] += d1;
+        grad[1] += d1 * x;
         h[0] += d2;
         h[1] += d2 * x;
         h[2] += d2 * x * x;
     }
-    (g, [h])
+    (grad, [h])
 }
 
-/// Fit θ and β by maximum likelihood (see the module docs).
-pub fn fit_lognormal(trials: &[Trial]) -> Result<Fragility, FragilityError> {
-    let trials: Vec<Trial> = trials.iter().copied().filter(|t| t.n > 0 && t.im > 0.0 && t.im.is_finite()).collect();
-    let runs: usize = trials.iter().map(|t| t.n).sum();
+/// Why the trials cannot give a fit before any is tried: no runs, none or all
+/// overturned, or survivals and overturnings separated in IM.
+fn check_trials(trials: &[Trial], runs: usize) -> Result<(), FragilityError> {
     let ks: usize = trials.iter().map(|t| t.k).sum();
     if runs == 0 {
         return Err(FragilityError::NoRuns);
@@ -134,28 +133,33 @@ pub fn fit_lognormal(trials: &[Trial]) -> Result<Fragility, FragilityError> {
             overturned_min,
         });
     }
-    // Start: θ at the geometric mean of the IMs, β = 0.5.
+    Ok(())
+}
+
+/// Newton's method with step halving on (a, b) from θ at the geometric mean of
+/// the IMs and β = 0.5: (a, b, log-likelihood, iterations).
+fn maximise(trials: &[Trial], runs: usize) -> Result<(f64, f64, f64, usize), FragilityError> {
     let mean_ln = trials.iter().map(|t| t.n as f64 * t.im.ln()).sum::<f64>() / runs as f64;
     let (mut a, mut b) = (-mean_ln / 0.5, 1.0 / 0.5);
-    let mut ll = log_likelihood(&trials, a, b);
+    let mut ll = log_likelihood(trials, a, b);
     let max_iter = 100;
     let mut iterations = 0;
     let mut converged = false;
     for it in 1..=max_iter {
         iterations = it;
-        let (g, [h]) = derivatives(&trials, a, b);
+        let (grad, [h]) = derivatives(trials, a, b);
         // Newton step δ = −H⁻¹ g (H negative definite).
         let det = h[0] * h[2] - h[1] * h[1];
         if !(det.is_finite() && det > 0.0) {
             break;
         }
-        let da = -(h[2] * g[0] - h[1] * g[1]) / det;
-        let db = -(-h[1] * g[0] + h[0] * g[1]) / det;
+        let da = -(h[2] * grad[0] - h[1] * grad[1]) / det;
+        let db = -(-h[1] * grad[0] + h[0] * grad[1]) / det;
         let mut step = 1.0;
         let mut accepted = false;
         for _ in 0..60 {
             let (na, nb) = (a + step * da, b + step * db);
-            let nll = log_likelihood(&trials, na, nb);
+            let nll = log_likelihood(trials, na, nb);
             if nll >= ll - 1e-12 * ll.abs() {
                 (a, b, ll) = (na, nb, nll);
                 accepted = true;
@@ -164,13 +168,23 @@ pub fn fit_lognormal(trials: &[Trial]) -> Result<Fragility, FragilityError> {
             step *= 0.5;
         }
         if !accepted || (da * step).abs() + (db * step).abs() < 1e-12 * (1.0 + a.abs() + b.abs()) {
-            converged = accepted || g[0].abs() + g[1].abs() < 1e-8 * runs as f64;
+            converged = accepted || grad[0].abs() + grad[1].abs() < 1e-8 * runs as f64;
             break;
         }
     }
-    if !converged {
-        return Err(FragilityError::NoConvergence(iterations));
+    if converged {
+        Ok((a, b, ll, iterations))
+    } else {
+        Err(FragilityError::NoConvergence(iterations))
     }
+}
+
+/// Fit θ and β by maximum likelihood (see the module docs).
+pub fn fit_lognormal(trials: &[Trial]) -> Result<Fragility, FragilityError> {
+    let trials: Vec<Trial> = trials.iter().copied().filter(|t| t.n > 0 && t.im > 0.0 && t.im.is_finite()).collect();
+    let runs: usize = trials.iter().map(|t| t.n).sum();
+    check_trials(&trials, runs)?;
+    let (a, b, ll, iterations) = maximise(&trials, runs)?;
     if b <= 0.0 {
         return Err(FragilityError::Decreasing { b });
     }
@@ -303,7 +317,7 @@ mod tests {
 
     #[test]
     fn grouping() {
-        let g = group(&[(0.3, true), (0.1, false), (0.3, false), (0.1, false)]);
-        assert_eq!(g, vec![Trial { im: 0.1, n: 2, k: 0 }, Trial { im: 0.3, n: 2, k: 1 }]);
+        let trials = group(&[(0.3, true), (0.1, false), (0.3, false), (0.1, false)]);
+        assert_eq!(trials, vec![Trial { im: 0.1, n: 2, k: 0 }, Trial { im: 0.3, n: 2, k: 1 }]);
     }
 }

@@ -6,11 +6,31 @@
 //! (inward) peak after release; v_{k+1}/v_k is the coefficient of the impact that
 //! follows peak k.
 //!
-//! Layout: the numeric core ([`signal`], [`peaks`], [`restitution`], [`tables`],
-//! [`solver`], [`wall`]) touches no files; the edges ([`ingest`], [`report`], `cli`) depend on it, never the reverse.
+//! Where the paper is:
+//! - Eq. 1 (the rocking equation of motion): [`solver::model`], integrated by the
+//!   Dormand–Prince 5(4) scheme in [`solver::integrator`], event by event in
+//!   [`solver::run`] (impacts, rest, uplift, overturning).
+//! - Eq. 2 (Housner's e_H = 1 − 1.5 sin²α): [`wall::housner_e`].
+//! - Eqs. 3–6 (e from the ratios of successive velocity peaks, e⁺ and e⁻ by
+//!   side, r = e / e_H; Tables 1–3's r₁, r₂) and their uncertainties:
+//!   [`restitution`].
+//! - The estimator of the velocity peaks (damped arcs fitted to the free-rocking
+//!   segments): [`peaks`], called per test by [`reduction`]; the campaign means
+//!   in [`campaign_means`].
+//! - The calibration of e by replaying the tests with the solver: [`calibrate`]
+//!   on [`fit`] (Levenberg–Marquardt); the façade study: [`facade`], one run in
+//!   [`study`], ensembles in [`ensemble`], fragility curves in [`fragility`].
+//!
+//! Layout: the numeric core (every module but [`ingest`], [`report`], `cli` and
+//! [`atomic`]) touches no files and names no clap, polars, plotters or anyhow type;
+//! the domain types ([`wall::Rocking`], [`wall::Side`], [`wall::Rectangle`],
+//! [`wall::Wall`]) live there. The edges depend on it, never the reverse
+//! (`tests/architecture.rs` checks it): [`ingest`] is the only reader of files,
+//! [`report`] renders and writes, `cli` is the binary.
 
 pub mod atomic;
 pub mod calibrate;
+pub mod campaign_means;
 pub mod ensemble;
 pub mod error;
 pub mod facade;
@@ -20,7 +40,7 @@ pub mod ground_motion;
 pub mod ingest;
 pub mod outcomes;
 pub mod peaks;
-pub mod reduce;
+pub mod reduction;
 pub mod report;
 pub mod restitution;
 pub mod signal;
@@ -28,15 +48,10 @@ pub mod solver;
 pub mod stats;
 pub mod study;
 pub mod synth;
-pub mod tables;
 pub mod wall;
 
-/// Seconds.
-pub type Seconds = f64;
-/// Radians.
-pub type Radians = f64;
-/// Millimetres.
-pub type Millimetres = f64;
+/// A campaign's reduction from its files (in [`ingest`]: it reads the logs).
+pub use ingest::reduce;
 
 /// Standard gravity, m/s² (also what ESM uses: g = 980.665 cm/s²).
 pub const G: f64 = 9.80665;

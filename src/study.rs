@@ -2,8 +2,8 @@
 //! study): build the model, scale the record, integrate, summarise.
 
 use crate::ground_motion::Record;
-use crate::ingest::block::BlockSpec;
-use crate::solver::{simulate, Ground, RockingModel, Settings, Simulation, Stop};
+use crate::solver::run::SolverError;
+use crate::solver::{simulate, BlockSpec, Ground, RockingModel, Settings, Simulation, Stop};
 
 /// Everything a run needs besides the block and the record.
 #[derive(Debug, Clone, Copy)]
@@ -63,15 +63,15 @@ pub fn ground(record: &Record, spec: &RunSpec) -> Ground {
 }
 
 /// Run one simulation from rest at the record's first sample.
-pub fn run(block: &BlockSpec, record: &Record, spec: &RunSpec) -> (RunSummary, Simulation) {
+pub fn run(block: &BlockSpec, record: &Record, spec: &RunSpec) -> Result<(RunSummary, Simulation), SolverError> {
     run_with(block, record, spec, true)
 }
 
 /// As [`run`], choosing whether a wall at rest after the last sample that could
 /// uplift it stops the run ([`Settings::stop_at_rest`]; `run` always does).
-pub fn run_with(block: &BlockSpec, record: &Record, spec: &RunSpec, stop_at_rest: bool) -> (RunSummary, Simulation) {
+pub fn run_with(block: &BlockSpec, record: &Record, spec: &RunSpec, stop_at_rest: bool) -> Result<(RunSummary, Simulation), SolverError> {
     let m = model(block, spec);
-    let g = ground(record, spec);
+    let ag = ground(record, spec);
     let mut settings = Settings::new(record.t0 + record.duration() + spec.t_extra).with_tolerances(spec.rtol, spec.atol);
     if !spec.keep_history {
         settings = settings.without_history();
@@ -80,7 +80,7 @@ pub fn run_with(block: &BlockSpec, record: &Record, spec: &RunSpec, stop_at_rest
         settings = settings.without_stop_at_rest();
     }
     let start = std::time::Instant::now();
-    let sim = simulate(&m, &g, record.t0, None, &settings);
+    let sim = simulate(&m, &ag, record.t0, None, &settings)?;
     let wall = start.elapsed().as_secs_f64();
     let alpha = block.block.alpha;
     let (overturned, t_ov) = match sim.stop {
@@ -98,5 +98,5 @@ pub fn run_with(block: &BlockSpec, record: &Record, spec: &RunSpec, stop_at_rest
         solve_wall_s: wall,
         steps: sim.steps,
     };
-    (summary, sim)
+    Ok((summary, sim))
 }

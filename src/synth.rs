@@ -531,9 +531,9 @@ pub fn score(s: &Synthetic) -> Scored {
     let spec = &s.spec;
     let phys = Physics {
         rocking: if spec.one_sided() {
-            crate::ingest::Rocking::OneSided
+            crate::wall::Rocking::OneSided
         } else {
-            crate::ingest::Rocking::TwoSided
+            crate::wall::Rocking::TwoSided
         },
         lever_arm_mm: spec.lever_mm,
         p_guess: spec.p2().sqrt(),

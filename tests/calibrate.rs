@@ -1,8 +1,9 @@
 //! Issue #4: the calibration recovers constant e_in/e_out from a campaign made with
 //! the project's own solver and a realistic sensor (noise 0.02–0.05 mm, 100–1000
 //! Hz, drift, quantisation to 0.01 mm). Tolerance 0.01 on each coefficient (the
-//! issue's bound; the fit's own 95 % half-intervals are 0.0002–0.0013 here, and
-//! the errors seen are below 0.0015).
+//! issue's bound); and the fits' 95 % intervals cover the true coefficients
+//! (half-widths 0.0002–0.0012 here, errors up to 0.0010), over many seeds at the
+//! rate a 95 % interval should.
 
 use std::path::Path;
 
@@ -17,6 +18,13 @@ use common::{synthetic_log, LogSpec};
 const E_IN: f64 = 0.55;
 const E_OUT: f64 = 0.75;
 const KAPPA: f64 = 80.0;
+
+const MANIFEST_HEAD: &str = "[campaign]\nname = \"synthetic\"\nrocking = \"one-sided\"\n[wall]\nheight_m = 2.70\nthickness_m = 0.36\nhinge_height_m = 0.23\n[channels]\ntime = { column = \"time_s\", unit = \"s\" }\ndisplacement = { column = \"disp_mm\", unit = \"mm\", height_m = 2.56 }\n";
+
+/// Whether the interval holds the value.
+fn covers(ci: [f64; 2], truth: f64) -> bool {
+    ci[0] <= truth && truth <= ci[1]
+}
 
 fn log(fs: f64, sigma: f64, drift_mm: f64, x0_mm: f64, seed: u64) -> String {
     synthetic_log(&LogSpec {
@@ -40,9 +48,7 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
         ("b", 200.0, 0.02, -0.1, 120.0),
         ("c", 1000.0, 0.03, 0.05, 100.0),
     ];
-    let mut manifest = String::from(
-        "[campaign]\nname = \"synthetic\"\nrocking = \"one-sided\"\n[wall]\nheight_m = 2.70\nthickness_m = 0.36\nhinge_height_m = 0.23\n[channels]\ntime = { column = \"time_s\", unit = \"s\" }\ndisplacement = { column = \"disp_mm\", unit = \"mm\", height_m = 2.56 }\n",
-    );
+    let mut manifest = String::from(MANIFEST_HEAD);
     for (i, (id, fs, sigma, drift, x0)) in tests.iter().enumerate() {
         std::fs::write(dir.path().join(format!("{id}.csv")), log(*fs, *sigma, *drift, *x0, 17 + i as u64)).unwrap();
         manifest.push_str(&format!("[[test]]\nid = \"{id}\"\nfile = \"{id}.csv\"\n"));
@@ -53,7 +59,7 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     for t in &res.tests {
         assert!(t.result.is_ok(), "{}: {:?}", t.spec.id, t.result.as_ref().err());
     }
-    let cal = calibrate(&res, 6);
+    let cal = calibrate(&res.calibration_input(), 6);
     assert!(cal.failed.is_empty(), "{:?}", cal.failed);
     for f in &cal.tests {
         println!(
@@ -68,7 +74,11 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
         );
         assert!((f.e_in - E_IN).abs() < 0.01, "{}: e_in {}", f.id, f.e_in);
         assert!((f.e_out - E_OUT).abs() < 0.01, "{}: e_out {}", f.id, f.e_out);
-        assert!(f.ci95_e_in[0] < f.e_in && f.e_in < f.ci95_e_in[1]);
+        // The 95 % intervals cover the coefficients the logs were made with (not
+        // merely the estimate: that was always true). Drift is not in the model,
+        // so this can fail; the coverage rate without drift is measured below.
+        assert!(covers(f.ci95_e_in, E_IN), "{}: e_in interval {:?} misses {E_IN}", f.id, f.ci95_e_in);
+        assert!(covers(f.ci95_e_out, E_OUT), "{}: e_out interval {:?} misses {E_OUT}", f.id, f.ci95_e_out);
     }
     assert!((cal.e_in - E_IN).abs() < 0.01 && (cal.e_out - E_OUT).abs() < 0.01);
     let j = cal.joint.clone().expect("joint fit");
@@ -80,13 +90,13 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     );
     // calibration.toml round-trips into the readers of simulate and the façade study.
     let toml_path = Path::new(dir.path()).join("calibration.toml");
-    std::fs::write(&toml_path, rocklab::calibrate::to_toml(&cal)).unwrap();
-    let (ei, eo) = rocklab::facade::read_calibration(&toml_path).unwrap();
+    std::fs::write(&toml_path, rocklab::calibrate::to_toml(&cal).unwrap()).unwrap();
+    let (ei, eo) = rocklab::ingest::calibration::read_coefficients(&toml_path).unwrap();
     assert_eq!((ei, eo), (cal.e_in, cal.e_out));
     // Issue 10: it carries what a façade ensemble draws from, and the study's
     // calibration set draws e_in ~ N(mean, √(sd_tests² + se_fit²)).
-    let file = rocklab::facade::read_calibration_file(&toml_path).unwrap();
-    let sp = file.spread.expect("[calibration.spread]");
+    let file = rocklab::ingest::calibration::read(&toml_path).unwrap().calibration;
+    let sp = file.spread.clone().expect("[calibration.spread]").spread;
     let inc: Vec<_> = cal.tests.iter().filter(|t| cal.included.contains(&t.id)).collect();
     assert_eq!(sp.n_tests, inc.len());
     let n = inc.len() as f64;
@@ -106,4 +116,57 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
         other => panic!("one-sided calibration gives a pair, not {other:?}"),
     }
     assert!(rocklab::facade::calibration_set("c", "f", &file, "sideways").is_err());
+}
+
+/// The fits' 95 % intervals over 16 seeded noisy tests (100–1000 Hz, σ 0.02–0.05
+/// mm, quantised to 0.01 mm, releases from 100–150 mm, no drift: the model is then
+/// exact), counted per coefficient: how often they cover the true e_in and e_out.
+///
+/// Measured: 15 of 16 for e_in and 15 of 16 for e_out (one test, s7, misses both:
+/// its two errors are correlated). Bound: at least 13 of 16 each. With honest 95 %
+/// intervals the chance of 4 or more misses out of 16 is 0.7 % (binomial), so a
+/// failure means the standard errors are too small or the fit biased; the seeds
+/// are fixed, so the test is deterministic.
+#[test]
+fn intervals_cover_the_true_coefficients() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 16u64;
+    let mut manifest = String::from(MANIFEST_HEAD);
+    for seed in 0..n {
+        let k = seed as usize;
+        let (fs, sigma, x0) = (
+            [100.0, 200.0, 500.0, 1000.0][k % 4],
+            [0.02, 0.03, 0.05][k % 3],
+            100.0 + 10.0 * (k % 6) as f64,
+        );
+        let id = format!("s{seed}");
+        std::fs::write(dir.path().join(format!("{id}.csv")), log(fs, sigma, 0.0, x0, 1000 + seed)).unwrap();
+        manifest.push_str(&format!("[[test]]\nid = \"{id}\"\nfile = \"{id}.csv\"\n"));
+    }
+    let path = dir.path().join("campaign.toml");
+    std::fs::write(&path, manifest).unwrap();
+    let res = reduce_campaign(Campaign::load(&path).unwrap(), PeakOptions::default());
+    let cal = calibrate(&res.calibration_input(), 6);
+    assert!(cal.failed.is_empty(), "{:?}", cal.failed);
+    assert_eq!(cal.tests.len(), n as usize);
+    let (mut covered_in, mut covered_out) = (0, 0);
+    for f in &cal.tests {
+        let (ci, co) = (covers(f.ci95_e_in, E_IN), covers(f.ci95_e_out, E_OUT));
+        let word = |c: bool| if c { "covers" } else { "MISSES" };
+        println!(
+            "{}: e_in {:.5} ± {:.5} ({}), e_out {:.5} ± {:.5} ({})",
+            f.id,
+            f.e_in,
+            1.96 * f.se_e_in,
+            word(ci),
+            f.e_out,
+            1.96 * f.se_e_out,
+            word(co)
+        );
+        covered_in += ci as usize;
+        covered_out += co as usize;
+    }
+    println!("coverage: e_in {covered_in}/{n}, e_out {covered_out}/{n}");
+    assert!(covered_in >= 13, "e_in intervals cover the truth in only {covered_in} of {n} tests");
+    assert!(covered_out >= 13, "e_out intervals cover the truth in only {covered_out} of {n} tests");
 }

@@ -72,7 +72,7 @@ fn rectangular_pulse_probability_matches_the_draws_above_housner_threshold() {
                 dt: td / steps as f64,
                 acc,
             };
-            let sim = simulate(&model, &g, 0.0, None, &Settings::new(td + 8.0).without_history());
+            let sim = simulate(&model, &g, 0.0, None, &Settings::new(td + 8.0).without_history()).unwrap();
             let ov = matches!(sim.stop, Stop::Overturned { .. });
             (
                 x.magnification,
@@ -105,7 +105,7 @@ fn identical_seeds_give_identical_outputs_on_any_thread_count() {
     let n = 3;
     let on = |threads: usize, study: &Study| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| run_ensembles(study, n, &|| {}))
+        pool.install(|| run_ensembles(study, n, &|| {})).unwrap()
     };
     let (rows1, s1) = on(1, &study);
     let (rows2, s2) = on(2, &study);
@@ -143,8 +143,8 @@ fn early_stop_at_rest_changes_no_result() {
                         atol: 1e-10,
                         keep_history: false,
                     };
-                    let (a, sa) = run_with(&study.block, &rec.record, &spec, true);
-                    let (b, sb) = run_with(&study.block, &rec.record, &spec, false);
+                    let (a, sa) = run_with(&study.block, &rec.record, &spec, true).unwrap();
+                    let (b, sb) = run_with(&study.block, &rec.record, &spec, false).unwrap();
                     let key = |s: &rocklab::study::RunSummary| {
                         (
                             s.max_theta_over_alpha.to_bits(),

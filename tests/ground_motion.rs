@@ -2,7 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use rocklab::ground_motion::{parse, read, Format, ReadOptions, Units};
+use rocklab::ground_motion::{parse, Format, ReadOptions, Units};
+use rocklab::ingest::record::read;
 
 fn gm(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ground-motions").join(rel)

@@ -8,6 +8,7 @@
 use std::path::Path;
 
 use rocklab::calibrate::{Calibration, TestFit};
+use rocklab::campaign_means::{CampaignMeans, Means};
 use rocklab::facade::{Study, StudyRun};
 use rocklab::fit::FitStop;
 use rocklab::report::calibration::{calibration_table, per_impact_table};
@@ -16,7 +17,6 @@ use rocklab::report::table::{to_csv, to_html, to_latex, to_markdown};
 use rocklab::report::tables::{campaign_tables, CampaignView, TestValues};
 use rocklab::restitution::Coefficients;
 use rocklab::study::RunSummary;
-use rocklab::tables::{CampaignMeans, Means};
 
 fn coefficients(x: f64) -> Coefficients {
     Coefficients {
@@ -91,7 +91,7 @@ fn campaign_table() -> rocklab::report::table::Table {
             },
             TestValues {
                 id: "100_1",
-                values: Err("logs/100_1.csv: line 9, column 2: 'abc' is not a number"),
+                values: Err("logs/100_1.csv: line 9, column 2: 'abc' is not a number".into()),
             },
         ],
         means: &m,
@@ -144,13 +144,14 @@ fn fit(id: &str, e_in: f64, e_out: f64) -> TestFit {
 fn calibration() -> Calibration {
     Calibration {
         campaign: "one-sided-demo".into(),
-        rocking: "one-sided".into(),
+        rocking: rocklab::wall::Rocking::OneSided,
         e_housner: 0.9738,
         e_in: 0.33,
         e_out: 0.66,
         r_in: 0.339,
         r_out: 0.678,
         joint: None,
+        joint_failure: None,
         tests: vec![fit("150_1", 0.312, 0.637), fit("150_2", 0.357, 0.852)],
         per_impact: vec![
             ("150_1".into(), vec![0.3148, 0.6050, 0.5602], vec![0.6129, 0.7636]),

@@ -2,6 +2,7 @@
 //! tolerance and why.
 
 use rocklab::solver::{simulate, Event, Ground, Restraint, RockingModel, Settings, Stop};
+use rocklab::wall::Side;
 use rocklab::G;
 
 const ALPHA: f64 = 0.2;
@@ -29,7 +30,7 @@ fn quiet() -> Ground {
     }
 }
 
-fn impacts(ev: &[Event]) -> Vec<(f64, i8, f64, f64)> {
+fn impacts(ev: &[Event]) -> Vec<(f64, Side, f64, f64)> {
     ev.iter()
         .filter_map(|e| match *e {
             Event::Impact {
@@ -56,7 +57,7 @@ fn linearized_period() {
     let theta0 = 0.5 * ALPHA;
     let p = P2.sqrt();
     let period = 4.0 / p * (1.0 / (1.0 - theta0 / ALPHA)).acosh();
-    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(5.0 * period));
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(5.0 * period)).unwrap();
     let imp = impacts(&sim.events);
     assert!(imp.len() >= 9, "{} impacts", imp.len());
     for (k, (t, ..)) in imp.iter().enumerate() {
@@ -108,7 +109,7 @@ fn nonlinear_period_and_energy() {
     let m = model(1.0, 1.0, false);
     let theta0 = 0.6 * ALPHA;
     let q = quarter_period_quadrature(theta0);
-    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(9.0 * q));
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(9.0 * q)).unwrap();
     let imp = impacts(&sim.events);
     assert!(imp.len() >= 4);
     for (k, (t, ..)) in imp.iter().enumerate() {
@@ -131,19 +132,19 @@ fn impacts_and_amplitudes() {
     let (e_in, e_out) = (0.8, 0.9);
     let m = model(e_in, e_out, false);
     let theta0 = 0.7 * ALPHA;
-    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(6.0));
+    let sim = simulate(&m, &quiet(), 0.0, Some([theta0, 0.0]), &tight(6.0)).unwrap();
     let imp = impacts(&sim.events);
     assert!(imp.len() >= 6);
     for (k, &(_, entering, vb, va)) in imp.iter().enumerate() {
-        let expected_entering = if k % 2 == 0 { -1 } else { 1 };
+        let expected_entering = if k % 2 == 0 { Side::Inward } else { Side::Outward };
         assert_eq!(entering, expected_entering, "impact {k}");
-        let e = if entering < 0 { e_in } else { e_out };
+        let e = if entering == Side::Inward { e_in } else { e_out };
         assert_eq!(va, e * vb, "impact {k}: exactly e times");
     }
     // Amplitude after impact k from the speed after it (energy on the new side).
     let mut amp = theta0;
     for &(_, entering, _, va) in imp.iter().take(5) {
-        let e = if entering < 0 { e_in } else { e_out };
+        let e = if entering == Side::Inward { e_in } else { e_out };
         let lhs_next = 0.5 * va * va / P2; // = cos(α − θₙ₊₁) − cos α
         let rhs = e * e * ((ALPHA - amp).cos() - ALPHA.cos());
         assert!((lhs_next / rhs - 1.0).abs() < 1e-9, "{lhs_next} vs {rhs}");
@@ -170,7 +171,7 @@ fn uplift_threshold() {
             dt: 0.5,
             acc: vec![a; 5],
         };
-        let sim = simulate(&m, &g, 0.0, None, &Settings::new(2.0));
+        let sim = simulate(&m, &g, 0.0, None, &Settings::new(2.0)).unwrap();
         let up = sim.events.iter().find_map(|e| match e {
             Event::Uplift { t, side } => Some((*t, *side)),
             _ => None,
@@ -178,7 +179,7 @@ fn uplift_threshold() {
         assert_eq!(up.is_some(), moves, "a = {a}");
         if let Some((t, side)) = up {
             assert!(t < 1e-9);
-            assert_eq!(side as f64, a.signum());
+            assert_eq!(side.sign(), a.signum());
             assert!(sim.max_theta.abs().max(sim.min_theta.abs()) > 0.0);
             assert_eq!(sim.max_theta > 0.0, a > 0.0);
         } else {
@@ -197,7 +198,7 @@ fn uplift_time_under_a_sine_pulse() {
     let dt = 1e-4;
     let acc: Vec<f64> = (0..=5000).map(|i| ap * (wp * i as f64 * dt).sin()).collect();
     let g = Ground { t0: 0.0, dt, acc };
-    let sim = simulate(&m, &g, 0.0, None, &Settings::new(0.3));
+    let sim = simulate(&m, &g, 0.0, None, &Settings::new(0.3)).unwrap();
     let t_up = sim.events.iter().find_map(|e| match e {
         Event::Uplift { t, .. } => Some(*t),
         _ => None,
@@ -227,7 +228,7 @@ fn rectangular_pulse_overturning() {
         let mut acc = vec![a; n + 1];
         acc.extend(std::iter::repeat_n(0.0, 10));
         let g = Ground { t0: 0.0, dt, acc };
-        simulate(&m, &g, 0.0, None, &Settings::new(td + 15.0).without_history()).stop
+        simulate(&m, &g, 0.0, None, &Settings::new(td + 15.0).without_history()).unwrap().stop
     };
     assert!(matches!(run(1.002, true), Stop::Overturned { .. }));
     assert_eq!(run(0.998, true), Stop::End);
@@ -241,9 +242,39 @@ fn rectangular_pulse_overturning() {
 fn one_sided_free_rocking_ends_at_rest() {
     let mut m = model(0.6, 0.7, false);
     m.restraint = Restraint::Rotational { k_nm_per_rad: 60.0 };
-    let sim = simulate(&m, &quiet(), 0.0, Some([0.5 * ALPHA, 0.0]), &Settings::new(60.0));
+    let sim = simulate(&m, &quiet(), 0.0, Some([0.5 * ALPHA, 0.0]), &Settings::new(60.0)).unwrap();
     assert!(sim.events.iter().any(|e| matches!(e, Event::Rest { .. })), "never came to rest");
     assert_eq!(sim.stop, Stop::End);
     assert!(sim.min_theta > -0.05 && sim.min_theta < 0.0);
     assert!(sim.steps < 200_000, "{} steps", sim.steps);
+}
+
+/// Issue #12: settings the solver cannot run with are an error that says which,
+/// not a panic (they used to assert!).
+#[test]
+fn unusable_settings_are_errors_not_panics() {
+    use rocklab::solver::run::SolverError;
+    let m = model(0.9, 0.9, false);
+    let run = |s: &Settings, initial: Option<[f64; 2]>| simulate(&m, &quiet(), 0.0, initial, s);
+    let e = run(&Settings::new(1.0).with_tolerances(0.0, 1e-12), None).unwrap_err();
+    assert_eq!(e, SolverError::Tolerances { rtol: 0.0, atol: 1e-12 });
+    assert!(e.to_string().contains("rtol = 0"), "{e}");
+    let mut s = Settings::new(1.0);
+    s.max_step = 0.0;
+    assert!(matches!(run(&s, None), Err(SolverError::NotPositive { what: "max_step", .. })));
+    assert!(matches!(run(&Settings::new(f64::NAN), None), Err(SolverError::EndTime { .. })));
+    assert!(matches!(
+        run(&Settings::new(1.0), Some([f64::NAN, 0.0])),
+        Err(SolverError::Initial { .. })
+    ));
+    let flat = Ground {
+        t0: 0.0,
+        dt: 0.0,
+        acc: vec![0.0; 2],
+    };
+    assert!(matches!(
+        simulate(&m, &flat, 0.0, None, &Settings::new(1.0)),
+        Err(SolverError::Ground { .. })
+    ));
+    assert!(run(&Settings::new(1.0), Some([0.5 * ALPHA, 0.0])).is_ok());
 }

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 
 use rocklab::facade::{run_ida, run_study, Study};
-use rocklab::ground_motion::{self, Format, ReadOptions, Record, Units};
+use rocklab::ground_motion::{Format, ReadOptions, Record, Units};
 use rocklab::ingest::block::BlockSpec;
 use rocklab::ingest::{Campaign, LogData};
 use rocklab::peaks::{Method, PeakOptions};
@@ -188,10 +188,13 @@ fn reduce_log<'py>(
 /// A block: a BLOCK.toml path, or the same tables as JSON (validated alike).
 fn load_block(path: Option<PathBuf>, json_text: Option<String>) -> anyhow::Result<BlockSpec> {
     match (path, json_text) {
-        (Some(p), None) => BlockSpec::load(&p),
+        (Some(p), None) => Ok(BlockSpec::load(&p)?),
         (None, Some(j)) => {
             let v: Value = serde_json::from_str(&j)?;
-            BlockSpec::parse(&toml::to_string(&v).context("the block as TOML")?, Path::new("<block>"))
+            Ok(BlockSpec::parse(
+                &toml::to_string(&v).context("the block as TOML")?,
+                Path::new("<block>"),
+            )?)
         }
         _ => bail!("give the block as a path or as a dict"),
     }
@@ -212,8 +215,8 @@ fn load_record(
         .transpose()?;
     match (path, acc) {
         (Some(p), None) => {
-            let format = Format::from_name(format.as_deref().unwrap_or("auto")).map_err(|e| anyhow!(e))?;
-            let rec = ground_motion::read(&p, &ReadOptions { format, dt, units })?;
+            let format = Format::from_name(format.as_deref().unwrap_or("auto"))?;
+            let rec = rocklab::ingest::record::read(&p, &ReadOptions { format, dt, units })?;
             Ok((p.display().to_string(), rec))
         }
         (None, Some(bytes)) => {
@@ -284,7 +287,7 @@ fn simulate<'py>(
         let (record_name, record) = load_record(record_path, acc, format, dt, units)?;
         let d = block.impact;
         let (e_in, e_out) = match (calibration, e, e_in, e_out) {
-            (Some(file), None, None, None) => rocklab::facade::read_calibration(&file)?,
+            (Some(file), None, None, None) => rocklab::ingest::calibration::read_coefficients(&file)?,
             (Some(_), ..) => bail!("give calibration, or e, or e_in with e_out: not several"),
             (None, Some(e), None, None) => (e, e),
             (None, None, Some(i), Some(o)) => (i, o),
@@ -313,7 +316,7 @@ fn simulate<'py>(
             atol,
             keep_history: history,
         };
-        let (summary, sim) = run(&block, &record, &spec);
+        let (summary, sim) = run(&block, &record, &spec)?;
         let doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
         let alpha = block.block.alpha;
         let h = &sim.history;
@@ -338,11 +341,11 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_campaign(campaign, PeakOptions::default());
         let start = Instant::now();
-        let cal = rocklab::calibrate::calibrate(&res, impacts);
+        let cal = rocklab::calibrate::calibrate(&res.calibration_input(), impacts);
         let wall = start.elapsed().as_secs_f64();
         let (mut doc, _) = reduce_doc(&res, false)?;
         doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall)?;
-        doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal));
+        doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal)?);
         Ok(doc)
     })?;
     Ok(doc.to_string())
@@ -356,9 +359,9 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
     let doc = guarded(py, move || {
         let study = Study::load(&study)?;
         let start = Instant::now();
-        let runs = run_study(&study, 1.0, false, &|| {});
+        let runs = run_study(&study, 1.0, false, &|| {})?;
         let wall = start.elapsed().as_secs_f64();
-        let ida = scales.map(|sc| run_ida(&study, &sc, &|| {}));
+        let ida = scales.map(|sc| run_ida(&study, &sc, &|| {})).transpose()?;
         Ok(json!({"summary": docs::facade_summary(&study, &runs, wall, None, None)?, "ida": ida}))
     })?;
     Ok(doc.to_string())
@@ -368,7 +371,7 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
 #[pyfunction]
 fn parse_scales(py: Python<'_>, text: &str) -> PyResult<Vec<f64>> {
     let text = text.to_string();
-    guarded(py, move || rocklab::facade::parse_scales(&text))
+    guarded(py, move || Ok(rocklab::facade::parse_scales(&text)?))
 }
 
 /// The records, coefficient sets and polarities of a study (in the order of its
@@ -434,9 +437,9 @@ fn facade_runs(py: Python<'_>, study: PathBuf, runs_json: &str, sensitivity: boo
         let one = |(key, scale): &((usize, usize, i64), f64)| -> anyhow::Result<Value> {
             let sub = &subs[key];
             Ok(if sensitivity {
-                serde_json::to_value(&run_study(sub, *scale, false, &|| {})[0])?
+                serde_json::to_value(&run_study(sub, *scale, false, &|| {})?[0])?
             } else {
-                serde_json::to_value(&run_ida(sub, &[*scale], &|| {})[0])?
+                serde_json::to_value(&run_ida(sub, &[*scale], &|| {})?[0])?
             })
         };
         let out: Vec<Value> = if parallel {

@@ -39,7 +39,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
 /// calibration on top, and print the calibration table.
 pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, n: usize) -> anyhow::Result<Calibration> {
     let start = std::time::Instant::now();
-    let cal = calibrate(res, n);
+    let cal = calibrate(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
     let files = calibration_files(res, &cal, n, wall, sources)?;
     write_files(out, &files).with_context(|| format!("writing {}", out.display()))?;

@@ -26,7 +26,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     // reduce → calibrate → façade: this campaign's calibration joins the study as
     // a coefficient set, read back from the calibration.toml just written.
     let cal_path = args.out.join("one-sided-demo").join("calibration.toml");
-    let cal = rocklab::facade::read_calibration_file(&cal_path)?;
+    let cal = rocklab::ingest::calibration::read(&cal_path)?.calibration;
     let set = rocklab::facade::calibration_set("campaign", &cal_path.display().to_string(), &cal, "tests").map_err(|e| anyhow::anyhow!(e))?;
     study.sets.push(set);
     let scales = rocklab::facade::parse_scales(&args.scales)?;

@@ -12,6 +12,7 @@ use super::{load, progress, say};
 use rocklab::facade::{fragility_by_set, parse_scales, run_ensembles, run_ida, run_ida_samples, run_study, SampleRun, Study};
 use rocklab::report::facade::{ensemble_source, facade_files, ida_source, FacadeResults};
 use rocklab::report::write_files;
+use rocklab::solver::run::SolverError;
 
 #[derive(Args, Debug)]
 pub struct FacadeArgs {
@@ -65,7 +66,7 @@ pub fn run(a: FacadeArgs) -> anyhow::Result<ExitCode> {
 /// The whole study (shared with `demo`): load the inputs' facts, run, write.
 pub fn run_and_write(study: &Study, scales: Option<&[f64]>, out: &Path) -> anyhow::Result<()> {
     let inputs = load::study_inputs(study);
-    let results = compute(study, scales);
+    let results = compute(study, scales)?;
     let (files, md) = facade_files(study, &results, &inputs)?;
     write_files(out, &files).with_context(|| format!("writing {}", out.display()))?;
     say(&md);
@@ -75,34 +76,35 @@ pub fn run_and_write(study: &Study, scales: Option<&[f64]>, out: &Path) -> anyho
 
 /// The core step: the nominal runs at scale 1, the ensembles (when `samples` > 0),
 /// the IDA (with `scales`) and the fragility fits, with progress on the terminal.
-fn compute(study: &Study, scales: Option<&[f64]>) -> FacadeResults {
+fn compute(study: &Study, scales: Option<&[f64]>) -> Result<FacadeResults, SolverError> {
     let start = Instant::now();
     let pb = progress(study.combinations().len(), "façade runs");
-    let runs = run_study(study, 1.0, true, &|| pb.inc(1));
+    let runs = run_study(study, 1.0, true, &|| pb.inc(1))?;
     pb.finish_and_clear();
     say(&format!(
         "{} nominal runs (each at 3 tolerances) in {:.2} s",
         runs.len(),
         start.elapsed().as_secs_f64()
     ));
-    let ensemble = (study.samples > 0).then(|| ensembles(study));
+    let ensemble = (study.samples > 0).then(|| ensembles(study)).transpose()?;
     let ens_samples = ensemble.as_ref().map_or(&[][..], |e| e.1.as_slice());
-    let fragility = fragility_samples(study, scales, ens_samples).map(|(source, samples)| (source, fragility_by_set(study, &samples)));
-    let ida = scales.map(|sc| (sc.to_vec(), ida(study, sc)));
-    FacadeResults {
+    let fragility =
+        fragility_samples(study, scales, ens_samples)?.map(|(source, samples): (String, Vec<SampleRun>)| (source, fragility_by_set(study, &samples)));
+    let ida = scales.map(|sc| ida(study, sc).map(|pts| (sc.to_vec(), pts))).transpose()?;
+    Ok(FacadeResults {
         runs,
         ensemble,
         fragility,
         ida,
         wall_s: start.elapsed().as_secs_f64(),
-    }
+    })
 }
 
-fn ensembles(study: &Study) -> (Vec<rocklab::facade::EnsembleRow>, Vec<SampleRun>) {
+fn ensembles(study: &Study) -> Result<(Vec<rocklab::facade::EnsembleRow>, Vec<SampleRun>), SolverError> {
     let n = study.samples;
     let pb = progress(study.records.len() * study.rows().len() * study.sets.len() * n, "ensemble runs");
     let start = Instant::now();
-    let (rows, samples) = run_ensembles(study, n, &|| pb.inc(1));
+    let (rows, samples) = run_ensembles(study, n, &|| pb.inc(1))?;
     pb.finish_and_clear();
     let wall = start.elapsed().as_secs_f64();
     say(&format!(
@@ -110,13 +112,13 @@ fn ensembles(study: &Study) -> (Vec<rocklab::facade::EnsembleRow>, Vec<SampleRun
         samples.len(),
         1e3 * wall / samples.len().max(1) as f64
     ));
-    (rows, samples)
+    Ok((rows, samples))
 }
 
 /// The runs the fragility is fitted to, and where they come from: an IDA over
 /// `scales` (with the study's IDA samples), else the scale-1 ensembles when there
 /// are two records or more.
-fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[SampleRun]) -> Option<(String, Vec<SampleRun>)> {
+fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[SampleRun]) -> Result<Option<(String, Vec<SampleRun>)>, SolverError> {
     if let Some(sc) = scales {
         let n = study.ida_samples;
         let pb = progress(
@@ -124,21 +126,21 @@ fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[Sampl
             "fragility runs",
         );
         let start = Instant::now();
-        let samples = run_ida_samples(study, sc, n, &|| pb.inc(1));
+        let samples = run_ida_samples(study, sc, n, &|| pb.inc(1))?;
         pb.finish_and_clear();
-        Some((ida_source(sc, n, samples.len(), start.elapsed().as_secs_f64()), samples))
+        Ok(Some((ida_source(sc, n, samples.len(), start.elapsed().as_secs_f64()), samples)))
     } else if !ens_samples.is_empty() && study.records.len() >= 2 {
-        Some((ensemble_source(ens_samples.len(), study.records.len()), ens_samples.to_vec()))
+        Ok(Some((ensemble_source(ens_samples.len(), study.records.len()), ens_samples.to_vec())))
     } else {
-        None
+        Ok(None)
     }
 }
 
 /// The IDA: every combination at every scale.
-fn ida(study: &Study, scales: &[f64]) -> Vec<rocklab::facade::IdaPoint> {
+fn ida(study: &Study, scales: &[f64]) -> Result<Vec<rocklab::facade::IdaPoint>, SolverError> {
     let pb = progress(scales.len() * study.combinations().len(), "IDA runs");
     let start = Instant::now();
-    let pts = run_ida(study, scales, &|| pb.inc(1));
+    let pts = run_ida(study, scales, &|| pb.inc(1))?;
     pb.finish_and_clear();
     say(&format!(
         "IDA: {} runs ({} scales × {} combinations) in {:.2} s",
@@ -147,5 +149,5 @@ fn ida(study: &Study, scales: &[f64]) -> Vec<rocklab::facade::IdaPoint> {
         study.combinations().len(),
         start.elapsed().as_secs_f64()
     ));
-    pts
+    Ok(pts)
 }

@@ -7,7 +7,7 @@ use anyhow::{bail, Context};
 use clap::{Args, ValueEnum};
 
 use super::say;
-use rocklab::ground_motion::{self, Format, ReadOptions, Units};
+use rocklab::ground_motion::{Format, ReadOptions, Units};
 use rocklab::ingest::block::BlockSpec;
 use rocklab::report::{docs, response, write_files, Files};
 use rocklab::study::{run, RunSpec};
@@ -112,7 +112,7 @@ fn coefficients_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result
 /// The run's settings from the arguments and the block file's defaults, validated.
 fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec> {
     let (e_in, e_out) = match &a.calibration {
-        Some(file) => rocklab::facade::read_calibration(file)?,
+        Some(file) => rocklab::ingest::calibration::read_coefficients(file)?,
         None => coefficients_from_args(a, block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
@@ -137,9 +137,9 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
 
 pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     let block = BlockSpec::load(&a.block)?;
-    let record = ground_motion::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
+    let record = rocklab::ingest::record::read(&a.record, &read_options(a.format, a.dt, a.units.as_deref())?)?;
     let spec = spec_from_args(&a, &block)?;
-    let (summary, sim) = run(&block, &record, &spec);
+    let (summary, sim) = run(&block, &record, &spec)?;
     let alpha = block.block.alpha;
     let mut files = Files::default();
     let doc = docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim)?;

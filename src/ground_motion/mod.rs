@@ -1,7 +1,7 @@
 //! Ground-motion records: ESM ASCII, PEER NGA `.AT2` (old and NGA-West2 headers),
 //! COSMOS V2, two columns (time, acceleration) and one column with a given dt;
-//! units g, m/s², cm/s². Readers parse text (the CLI reads the file) and name the
-//! line of every defect.
+//! units g, m/s², cm/s². Readers parse text (`rocklab::ingest::record` reads the
+//! file) and name the line of every defect.
 
 use std::path::{Path, PathBuf};
 
@@ -48,7 +48,7 @@ pub enum Format {
 impl Format {
     /// The names a study file or the Python API uses for a format: `Ok(None)` for
     /// "auto" (detect it), an error naming the accepted names otherwise.
-    pub fn from_name(name: &str) -> Result<Option<Format>, String> {
+    pub fn from_name(name: &str) -> Result<Option<Format>, UnknownFormat> {
         match name {
             "auto" => Ok(None),
             "esm" => Ok(Some(Format::Esm)),
@@ -56,10 +56,15 @@ impl Format {
             "cosmos" => Ok(Some(Format::Cosmos)),
             "two-column" => Ok(Some(Format::TwoColumn)),
             "one-column" => Ok(Some(Format::OneColumn)),
-            other => Err(format!("format = {other:?}: expected auto, esm, at2, cosmos, two-column or one-column")),
+            other => Err(UnknownFormat(other.to_string())),
         }
     }
 }
+
+/// A format name that is none of [`Format::from_name`]'s.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("format = {0:?}: expected auto, esm, at2, cosmos, two-column or one-column")]
+pub struct UnknownFormat(pub String);
 
 /// A uniformly sampled record, in m/s².
 #[derive(Debug, Clone)]
@@ -109,22 +114,6 @@ fn err(path: &Path, line: usize, message: impl Into<String>) -> InputError {
         line: line as u64,
         message: message.into(),
     }
-}
-
-/// Read a record file.
-pub fn read(path: &Path, opts: &ReadOptions) -> Result<Record, InputError> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound {
-            InputError::Missing { file: path.to_path_buf() }
-        } else {
-            InputError::Io {
-                file: path.to_path_buf(),
-                source: e,
-            }
-        }
-    })?;
-    let text = String::from_utf8_lossy(&bytes);
-    parse(path, &text, opts)
 }
 
 /// Lines of a text with any of LF, CRLF, CR CR LF or CR line ends (1-based numbers).

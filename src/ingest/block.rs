@@ -29,7 +29,11 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::error::{FileError, FileKind};
+use crate::ingest::text::{parse_toml, read_text};
+pub use crate::solver::block::{BlockSpec, ImpactDefaults};
 use crate::solver::{Block, Restraint, TieRod};
+use crate::wall::Rectangle;
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -71,116 +75,109 @@ struct RawTie {
     yield_force_kn: Option<f64>,
 }
 
-/// Optional impact defaults of a block file.
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ImpactDefaults {
-    pub e: Option<f64>,
-    pub e_in: Option<f64>,
-    pub e_out: Option<f64>,
-    pub overturn_limit_rad: Option<f64>,
-}
-
 type RawImpact = ImpactDefaults;
 
-/// A validated block file.
-#[derive(Debug, Clone)]
-pub struct BlockSpec {
-    pub name: String,
-    pub block: Block,
-    pub restraint: Restraint,
-    pub ties: Vec<TieRod>,
-    pub impact: ImpactDefaults,
-    /// (K'_c in MN/m², contact height in m) when the restraint is given as a
-    /// spring bed (the façade ensembles vary them).
-    pub spring_bed: Option<(f64, f64)>,
-    /// Which of R, α, I_0, mass were overridden.
-    pub overrides: Vec<String>,
-}
+type Result<T> = std::result::Result<T, FileError>;
 
-fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
+fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(anyhow::anyhow!("{}: {key} = {v}: expected a positive number", path.display()))
+        Err(FileError::invalid(path, format!("{key} = {v}: expected a positive number")))
     }
 }
 
+/// The rectangular block with the overrides of R, α, I_0 and mass, and which were
+/// given.
+fn block(b: &RawBlock, path: &Path) -> Result<(Block, Vec<String>)> {
+    let geom = Rectangle::new(
+        positive(path, "[block].height_m", b.height_m)?,
+        positive(path, "[block].thickness_m", b.thickness_m)?,
+    );
+    let mut block = Block::rectangular(
+        geom,
+        positive(path, "[block].width_m", b.width_m)?,
+        positive(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3)?,
+    );
+    let mut overrides = Vec::new();
+    if let Some(m) = b.mass_kg {
+        block.mass_kg = positive(path, "[block].mass_kg", m)?;
+        overrides.push("mass_kg".into());
+    }
+    if let Some(r) = b.r_m {
+        block.r_m = positive(path, "[block].r_m", r)?;
+        overrides.push("r_m".into());
+    }
+    if let Some(a) = b.alpha_rad {
+        if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+            return Err(FileError::invalid(path, format!("[block].alpha_rad = {a}: expected 0 < α < π/2")));
+        }
+        block.alpha = a;
+        overrides.push("alpha_rad".into());
+    }
+    // I_0 = 4/3 m R² with the final m and R unless given.
+    block.i0 = match b.i0_kg_m2 {
+        Some(i) => {
+            overrides.push("i0_kg_m2".into());
+            positive(path, "[block].i0_kg_m2", i)?
+        }
+        None => Block::rectangular_i0(block.mass_kg, block.r_m),
+    };
+    Ok((block, overrides))
+}
+
+/// `[restraint]`: a spring bed (also returned as (K'_c, h) for the ensembles) or
+/// a rotational stiffness; none without the table.
+fn restraint(r: Option<&RawRestraint>, path: &Path) -> Result<(Restraint, Option<(f64, f64)>)> {
+    let Some(r) = r else {
+        return Ok((Restraint::None, None));
+    };
+    match (r.unit_stiffness_mn_m2, r.contact_height_m, r.rotational_stiffness_mnm_rad) {
+        (Some(k), Some(h), None) => Ok((
+            Restraint::spring_bed(positive(path, "unit_stiffness_mn_m2", k)? * 1e6, positive(path, "contact_height_m", h)?),
+            Some((k, h)),
+        )),
+        (None, None, Some(k)) => Ok((
+            Restraint::Rotational {
+                k_nm_per_rad: positive(path, "rotational_stiffness_mnm_rad", k)? * 1e6,
+            },
+            None,
+        )),
+        _ => Err(FileError::invalid(
+            path,
+            "[restraint]: give unit_stiffness_mn_m2 with contact_height_m, or rotational_stiffness_mnm_rad alone",
+        )),
+    }
+}
+
+fn tie_rod(t: &RawTie, path: &Path) -> Result<TieRod> {
+    Ok(TieRod {
+        stiffness_n_m: positive(path, "[[tie_rod]].stiffness_kn_m", t.stiffness_kn_m)? * 1e3,
+        height_m: positive(path, "[[tie_rod]].height_m", t.height_m)?,
+        yield_force_n: t
+            .yield_force_kn
+            .map(|f| positive(path, "[[tie_rod]].yield_force_kn", f).map(|v| v * 1e3))
+            .transpose()?,
+    })
+}
+
+/// The reader of a block file (the type is the solver's).
 impl BlockSpec {
-    pub fn load(path: &Path) -> anyhow::Result<BlockSpec> {
-        let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: cannot read block file: {e}", path.display()))?;
-        Self::parse(&text, path)
+    pub fn load(path: &Path) -> Result<BlockSpec> {
+        Self::parse(&read_text(path, FileKind::Block)?, path)
     }
 
-    pub fn parse(text: &str, path: &Path) -> anyhow::Result<BlockSpec> {
-        let raw: RawFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
-        let b = &raw.block;
-        let mut block = Block::rectangular(
-            positive(path, "[block].height_m", b.height_m)?,
-            positive(path, "[block].thickness_m", b.thickness_m)?,
-            positive(path, "[block].width_m", b.width_m)?,
-            positive(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3)?,
-        );
-        let mut overrides = Vec::new();
-        if let Some(m) = b.mass_kg {
-            block.mass_kg = positive(path, "[block].mass_kg", m)?;
-            overrides.push("mass_kg".into());
-        }
-        if let Some(r) = b.r_m {
-            block.r_m = positive(path, "[block].r_m", r)?;
-            overrides.push("r_m".into());
-        }
-        if let Some(a) = b.alpha_rad {
-            if !(a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
-                anyhow::bail!("{}: [block].alpha_rad = {a}: expected 0 < α < π/2", path.display());
-            }
-            block.alpha = a;
-            overrides.push("alpha_rad".into());
-        }
-        // I_0 = 4/3 m R² with the final m and R unless given.
-        block.i0 = match b.i0_kg_m2 {
-            Some(i) => {
-                overrides.push("i0_kg_m2".into());
-                positive(path, "[block].i0_kg_m2", i)?
-            }
-            None => 4.0 / 3.0 * block.mass_kg * block.r_m * block.r_m,
-        };
-        let spring_bed = raw
-            .restraint
-            .as_ref()
-            .and_then(|r| r.unit_stiffness_mn_m2.zip(r.contact_height_m))
-            .filter(|_| raw.restraint.as_ref().is_some_and(|r| r.rotational_stiffness_mnm_rad.is_none()));
-        let restraint = match &raw.restraint {
-            None => Restraint::None,
-            Some(r) => match (r.unit_stiffness_mn_m2, r.contact_height_m, r.rotational_stiffness_mnm_rad) {
-                (Some(k), Some(h), None) => {
-                    Restraint::spring_bed(positive(path, "unit_stiffness_mn_m2", k)? * 1e6, positive(path, "contact_height_m", h)?)
-                }
-                (None, None, Some(k)) => Restraint::Rotational {
-                    k_nm_per_rad: positive(path, "rotational_stiffness_mnm_rad", k)? * 1e6,
-                },
-                _ => anyhow::bail!(
-                    "{}: [restraint]: give unit_stiffness_mn_m2 with contact_height_m, or rotational_stiffness_mnm_rad alone",
-                    path.display()
-                ),
-            },
-        };
-        let ties = raw
-            .tie_rod
-            .iter()
-            .map(|t| {
-                Ok(TieRod {
-                    stiffness_n_m: positive(path, "[[tie_rod]].stiffness_kn_m", t.stiffness_kn_m)? * 1e3,
-                    height_m: positive(path, "[[tie_rod]].height_m", t.height_m)?,
-                    yield_force_n: t
-                        .yield_force_kn
-                        .map(|f| positive(path, "[[tie_rod]].yield_force_kn", f).map(|v| v * 1e3))
-                        .transpose()?,
-                })
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
+    pub fn parse(text: &str, path: &Path) -> Result<BlockSpec> {
+        Self::validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
+    }
+
+    fn validate(raw: RawFile, path: &Path) -> Result<BlockSpec> {
+        let (block, overrides) = block(&raw.block, path)?;
+        let (restraint, spring_bed) = restraint(raw.restraint.as_ref(), path)?;
+        let ties = raw.tie_rod.iter().map(|t| tie_rod(t, path)).collect::<Result<Vec<_>>>()?;
         Ok(BlockSpec {
-            name: b
+            name: raw
+                .block
                 .name
                 .clone()
                 .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()),

@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::InputError;
+pub use crate::reduction::LogData;
 
 /// Field delimiter of a log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -50,16 +51,14 @@ pub struct LogFormat {
     pub decimal: Option<Decimal>,
 }
 
-/// The two channels of one log, in seconds and millimetres, outward positive.
-#[derive(Debug, Clone, Default)]
-pub struct LogData {
-    pub time_s: Vec<f64>,
-    /// Displacement at the sensor, mm, positive OUTWARD (the file's sign × outward_sign).
-    pub disp_mm: Vec<f64>,
-    /// What was read and how, e.g. "delimiter ';' (detected)".
-    pub notes: Vec<String>,
-    /// Every warning raised while reading (a dropped truncated line, …).
-    pub warnings: Vec<String>,
+/// Where the channels are in a log: column indices (0-based) and the header.
+struct Columns {
+    /// Number of columns the header names.
+    n_names: usize,
+    /// 1-based line of the header row.
+    header_line: u64,
+    time: usize,
+    disp: usize,
 }
 
 /// Builder of a log reader: `LogReader::new(path).time("time_s", 1.0)…read()`.
@@ -105,17 +104,7 @@ impl LogReader {
 
     /// Read the file.
     pub fn read(&self) -> Result<LogData, InputError> {
-        let bytes = std::fs::read(&self.path).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::NotFound {
-                InputError::Missing { file: self.path.clone() }
-            } else {
-                InputError::Io {
-                    file: self.path.clone(),
-                    source: e,
-                }
-            }
-        })?;
-        self.parse(&bytes)
+        self.parse(&crate::ingest::text::read_bytes(&self.path)?)
     }
 
     /// Parse the bytes of a log (the path only names it in messages).
@@ -135,14 +124,42 @@ impl LogReader {
             .trim(csv::Trim::All)
             .from_reader(bytes);
         let mut rec = csv::ByteRecord::new();
-        let read = |rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord| {
-            rdr.read_byte_record(rec).map_err(|e| InputError::File {
+        let cols = self.header(&mut rdr, &mut rec, bytes)?;
+        let approx_rows = bytes.len() / 16;
+        data.time_s.reserve(approx_rows);
+        data.disp_mm.reserve(approx_rows);
+        if let Some((line, e)) = self.rows(&mut rdr, &mut rec, &cols, decimal, &mut data)? {
+            // A defect on a last line without a line end: the export was cut off.
+            if bytes.last().is_some_and(|b| *b == b'\n' || *b == b'\r') {
+                return Err(e);
+            }
+            data.warnings.push(format!(
+                "{}:{line}: truncated last line (no line end, {e_short}) dropped",
+                file.display(),
+                e_short = short(&e)
+            ));
+        }
+        if data.time_s.is_empty() {
+            return Err(InputError::NoData {
                 file: file.clone(),
-                message: format!("not readable as delimited text: {e}"),
-            })
-        };
-        // Header row.
-        if !read(&mut rdr, &mut rec)? {
+                line: cols.header_line,
+            });
+        }
+        Ok(data)
+    }
+
+    /// The next record, or false at the end.
+    fn next_record(&self, rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord) -> Result<bool, InputError> {
+        rdr.read_byte_record(rec).map_err(|e| InputError::File {
+            file: self.path.clone(),
+            message: format!("not readable as delimited text: {e}"),
+        })
+    }
+
+    /// Read the header row and find the time and displacement columns.
+    fn header(&self, rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord, bytes: &[u8]) -> Result<Columns, InputError> {
+        let file = &self.path;
+        if !self.next_record(rdr, rec)? {
             return Err(InputError::File {
                 file: file.clone(),
                 message: "only '#' metadata lines: expected a header row and numeric rows".into(),
@@ -161,16 +178,29 @@ impl LogReader {
                 ),
             })
         };
-        let it = find(&self.time_column, "time")?;
-        let id = find(&self.disp_column, "displacement")?;
-        let need = it.max(id) + 1;
-        let ends_with_newline = bytes.last().is_some_and(|b| *b == b'\n' || *b == b'\r');
-        let approx_rows = bytes.len() / 16;
-        data.time_s.reserve(approx_rows);
-        data.disp_mm.reserve(approx_rows);
+        let time = find(&self.time_column, "time")?;
+        let disp = find(&self.disp_column, "displacement")?;
+        Ok(Columns {
+            n_names: names.len(),
+            header_line,
+            time,
+            disp,
+        })
+    }
+
+    /// Read the numeric rows into `data`. A defective row is an error unless it is
+    /// the last one: then it is returned (line, error) for the caller to judge.
+    fn rows(
+        &self,
+        rdr: &mut csv::Reader<&[u8]>,
+        rec: &mut csv::ByteRecord,
+        cols: &Columns,
+        decimal: Decimal,
+        data: &mut LogData,
+    ) -> Result<Option<(u64, InputError)>, InputError> {
         let mut pending: Option<(u64, InputError)> = None;
         let mut buf = Vec::with_capacity(32);
-        while read(&mut rdr, &mut rec)? {
+        while self.next_record(rdr, rec)? {
             let line = rec.position().map_or(0, |p| p.line());
             if let Some((_, e)) = pending.take() {
                 // A defect that was not on the last line is an error.
@@ -179,39 +209,11 @@ impl LogReader {
             if rec.len() == 1 && rec.get(0).is_some_and(|f| f.is_empty()) {
                 continue; // blank line
             }
-            let row = (|| {
-                if rec.len() < need {
-                    return Err(InputError::At {
-                        file: file.clone(),
-                        line,
-                        column: rec.len() + 1,
-                        message: format!(
-                            "row has {} fields, the header has {}: expected a value for column '{}'",
-                            rec.len(),
-                            names.len(),
-                            if rec.len() <= it { &self.time_column } else { &self.disp_column }
-                        ),
-                    });
-                }
-                let t = parse_cell(rec.get(it).unwrap_or(b""), decimal, &mut buf).map_err(|m| at(file, line, it, &self.time_column, m))?;
-                let x = parse_cell(rec.get(id).unwrap_or(b""), decimal, &mut buf).map_err(|m| at(file, line, id, &self.disp_column, m))?;
-                Ok((t * self.time_scale, x * self.disp_scale, t))
-            })();
-            match row {
+            match self.row(rec, cols, line, decimal, &mut buf) {
                 Ok((t, x, t_raw)) => {
                     if let Some(&prev) = data.time_s.last() {
                         if t <= prev {
-                            let what = if t == prev { "duplicated" } else { "decreasing" };
-                            return Err(at(
-                                file,
-                                line,
-                                it,
-                                &self.time_column,
-                                format!(
-                                    "time {t_raw} is {what} (previous row {}): expected strictly increasing time",
-                                    prev / self.time_scale
-                                ),
-                            ));
+                            return Err(self.not_increasing(line, cols, t_raw, t == prev, prev));
                         }
                     }
                     data.time_s.push(t);
@@ -220,23 +222,44 @@ impl LogReader {
                 Err(e) => pending = Some((line, e)),
             }
         }
-        if let Some((line, e)) = pending {
-            if ends_with_newline {
-                return Err(e);
-            }
-            data.warnings.push(format!(
-                "{}:{line}: truncated last line (no line end, {e_short}) dropped",
-                file.display(),
-                e_short = short(&e)
-            ));
-        }
-        if data.time_s.is_empty() {
-            return Err(InputError::NoData {
+        Ok(pending)
+    }
+
+    /// One row: (time in s, displacement in outward mm, time as written).
+    fn row(&self, rec: &csv::ByteRecord, cols: &Columns, line: u64, decimal: Decimal, buf: &mut Vec<u8>) -> Result<(f64, f64, f64), InputError> {
+        let file = &self.path;
+        let (it, id) = (cols.time, cols.disp);
+        if rec.len() < it.max(id) + 1 {
+            return Err(InputError::At {
                 file: file.clone(),
-                line: header_line,
+                line,
+                column: rec.len() + 1,
+                message: format!(
+                    "row has {} fields, the header has {}: expected a value for column '{}'",
+                    rec.len(),
+                    cols.n_names,
+                    if rec.len() <= it { &self.time_column } else { &self.disp_column }
+                ),
             });
         }
-        Ok(data)
+        let t = parse_cell(rec.get(it).unwrap_or(b""), decimal, buf).map_err(|m| at(file, line, it, &self.time_column, m))?;
+        let x = parse_cell(rec.get(id).unwrap_or(b""), decimal, buf).map_err(|m| at(file, line, id, &self.disp_column, m))?;
+        Ok((t * self.time_scale, x * self.disp_scale, t))
+    }
+
+    /// A time that does not increase.
+    fn not_increasing(&self, line: u64, cols: &Columns, t_raw: f64, duplicated: bool, prev: f64) -> InputError {
+        let what = if duplicated { "duplicated" } else { "decreasing" };
+        at(
+            &self.path,
+            line,
+            cols.time,
+            &self.time_column,
+            format!(
+                "time {t_raw} is {what} (previous row {}): expected strictly increasing time",
+                prev / self.time_scale
+            ),
+        )
     }
 
     fn resolve_format(&self, bytes: &[u8], notes: &mut Vec<String>) -> Result<(Delimiter, Decimal), InputError> {

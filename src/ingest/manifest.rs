@@ -6,25 +6,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
+use crate::error::{FileError, FileKind};
 use crate::ingest::log::{Decimal, Delimiter, LogFormat};
-use crate::wall::{housner_e, p_squared_rectangular, slenderness, Provenance};
-
-/// One-sided (transverse walls restrain the inward side) or two-sided rocking.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Rocking {
-    OneSided,
-    TwoSided,
-}
-
-impl Rocking {
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Rocking::OneSided => "one-sided",
-            Rocking::TwoSided => "two-sided",
-        }
-    }
-}
+use crate::ingest::text::{parse_toml, read_text};
+pub use crate::wall::Rocking;
+use crate::wall::{housner_e, slenderness, Provenance, Wall};
 
 /// Unit of the time column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -179,47 +165,43 @@ pub struct Campaign {
 }
 
 impl Campaign {
-    /// Height of the rocking part above the hinge, m.
-    pub fn rocking_height_m(&self) -> f64 {
-        self.height_m - self.hinge_height_m
-    }
-
-    /// Slenderness of the rocking part above the hinge (used as a starting value of
-    /// the physics-based velocity estimator, which then fits it).
-    pub fn alpha_dynamic(&self) -> f64 {
-        slenderness(self.thickness_m, self.rocking_height_m())
+    /// The tested wall, as the core takes it.
+    pub fn wall(&self) -> Wall {
+        Wall {
+            height_m: self.height_m,
+            thickness_m: self.thickness_m,
+            hinge_height_m: self.hinge_height_m,
+            alpha_rad: self.alpha_rad,
+            alpha_source: self.alpha_source.clone(),
+            e_housner: self.e_housner,
+            e_housner_source: self.e_housner_source.clone(),
+        }
     }
 
     /// p² of the rocking part above the hinge (rectangular block), s⁻².
     pub fn p_squared(&self) -> f64 {
-        p_squared_rectangular(self.rocking_height_m(), self.thickness_m)
+        self.wall().rocking_part().p_squared()
     }
 
     /// Read and validate a manifest file.
-    pub fn load(path: &Path) -> anyhow::Result<Campaign> {
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::NotFound {
-                anyhow::anyhow!("{}: manifest not found", path.display())
-            } else {
-                anyhow::anyhow!("{}: cannot read manifest: {e}", path.display())
-            }
-        })?;
-        Self::parse(&text, path)
+    pub fn load(path: &Path) -> Result<Campaign> {
+        Self::parse(&read_text(path, FileKind::Manifest)?, path)
     }
 
     /// Parse and validate manifest text; `path` names it in errors and resolves the
     /// test files.
-    pub fn parse(text: &str, path: &Path) -> anyhow::Result<Campaign> {
-        let raw: RawManifest = toml::from_str(text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
-        validate(raw, path)
+    pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
+        validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
     }
 }
 
-fn bad(path: &Path, msg: impl std::fmt::Display) -> anyhow::Error {
-    anyhow::anyhow!("{}: {msg}", path.display())
+type Result<T> = std::result::Result<T, FileError>;
+
+fn bad(path: &Path, msg: impl std::fmt::Display) -> FileError {
+    FileError::invalid(path, msg)
 }
 
-fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
+fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
@@ -227,7 +209,7 @@ fn positive(path: &Path, key: &str, v: f64) -> anyhow::Result<f64> {
     }
 }
 
-fn sign(path: &Path, where_: &str, v: i64) -> anyhow::Result<f64> {
+fn sign(path: &Path, where_: &str, v: i64) -> Result<f64> {
     match v {
         1 => Ok(1.0),
         -1 => Ok(-1.0),
@@ -235,7 +217,7 @@ fn sign(path: &Path, where_: &str, v: i64) -> anyhow::Result<f64> {
     }
 }
 
-fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> anyhow::Result<LogFormat> {
+fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> Result<LogFormat> {
     let delimiter = match f.delimiter.as_deref() {
         None => None,
         Some(",") => Some(Delimiter::Comma),
@@ -258,8 +240,17 @@ fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> anyhow::Result<LogF
     Ok(LogFormat { delimiter, decimal })
 }
 
-fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
-    let w = &raw.wall;
+/// The `[wall]` table validated: height, thickness, α and e_H with provenance.
+struct WallValues {
+    height_m: f64,
+    thickness_m: f64,
+    alpha_rad: f64,
+    alpha_source: Provenance,
+    e_housner: f64,
+    e_housner_source: Provenance,
+}
+
+fn validate_wall(w: &RawWall, path: &Path) -> Result<WallValues> {
     let height_m = positive(path, "[wall].height_m", w.height_m)?;
     let thickness_m = positive(path, "[wall].thickness_m", w.thickness_m)?;
     if !(w.hinge_height_m.is_finite() && w.hinge_height_m >= 0.0 && w.hinge_height_m < height_m) {
@@ -289,94 +280,130 @@ fn validate(raw: RawManifest, path: &Path) -> anyhow::Result<Campaign> {
         }
         None => (housner_e(alpha_rad), Provenance::Computed(format!("Eq. 2, 1 − 1.5 sin²({alpha_rad:.4})"))),
     };
-    let defaults = raw.channels.clone().unwrap_or_default();
-    let campaign_format = match &raw.format {
-        Some(f) => parse_format(path, "[format].", f)?,
-        None => LogFormat::default(),
+    Ok(WallValues {
+        height_m,
+        thickness_m,
+        alpha_rad,
+        alpha_source,
+        e_housner,
+        e_housner_source,
+    })
+}
+
+/// What every test inherits: the `[channels]` defaults, the `[format]`, the
+/// manifest's folder and the hinge height.
+struct Defaults<'a> {
+    channels: RawChannels,
+    format: LogFormat,
+    base: &'a Path,
+    hinge_height_m: f64,
+}
+
+/// The channels of one test: its own, then its nested `channels`, then the defaults.
+fn test_channels(t: &RawTest, d: &Defaults, path: &Path, where_: &str) -> Result<(TimeChannel, DisplacementChannel, f64)> {
+    let nested = t.channels.clone().unwrap_or_default();
+    let time = t
+        .time
+        .clone()
+        .or(nested.time)
+        .or(d.channels.time.clone())
+        .ok_or_else(|| bad(path, format!("{where_}no time channel: set [channels].time or time in this [[test]]")))?;
+    let displacement = t
+        .displacement
+        .clone()
+        .or(nested.displacement)
+        .or(d.channels.displacement.clone())
+        .ok_or_else(|| {
+            bad(
+                path,
+                format!("{where_}no displacement channel: set [channels].displacement or displacement in this [[test]]"),
+            )
+        })?;
+    let outward_sign = sign(
+        path,
+        where_,
+        t.outward_sign.or(nested.outward_sign).or(d.channels.outward_sign).unwrap_or(1),
+    )?;
+    Ok((time, displacement, outward_sign))
+}
+
+/// One `[[test]]` validated, its channels resolved.
+fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
+    let where_ = format!("[[test]] id = {:?}: ", t.id);
+    let (time, displacement, outward_sign) = test_channels(t, d, path, &where_)?;
+    let sensor_h = displacement.height_m.ok_or_else(|| {
+        bad(
+            path,
+            format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"),
+        )
+    })?;
+    let sensor_h = positive(path, "displacement.height_m", sensor_h)?;
+    let lever_arm_m = sensor_h - d.hinge_height_m;
+    if lever_arm_m <= 0.0 {
+        return Err(bad(
+            path,
+            format!("{where_}sensor height {sensor_h} m is not above the hinge ({} m)", d.hinge_height_m),
+        ));
+    }
+    let format = match &t.format {
+        Some(f) => parse_format(path, &format!("{where_}format."), f)?,
+        None => d.format,
     };
-    let base = path.parent().unwrap_or_else(|| Path::new("."));
+    if let Some(x) = t.imposed_displacement_mm {
+        positive(path, "imposed_displacement_mm", x)?;
+    }
+    Ok(TestSpec {
+        id: t.id.clone(),
+        file: d.base.join(&t.file),
+        imposed_displacement_mm: t.imposed_displacement_mm,
+        exclude_from_mean: t.exclude_from_mean,
+        time,
+        displacement,
+        outward_sign,
+        format,
+        lever_arm_m,
+    })
+}
+
+fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
+    let w = &raw.wall;
+    let wall = validate_wall(w, path)?;
+    let defaults = Defaults {
+        channels: raw.channels.clone().unwrap_or_default(),
+        format: match &raw.format {
+            Some(f) => parse_format(path, "[format].", f)?,
+            None => LogFormat::default(),
+        },
+        base: path.parent().unwrap_or_else(|| Path::new(".")),
+        hinge_height_m: w.hinge_height_m,
+    };
     if raw.test.is_empty() {
         return Err(bad(path, "no [[test]] entries: expected at least one test"));
     }
     let mut tests = Vec::with_capacity(raw.test.len());
     let mut seen = std::collections::HashSet::new();
     for t in &raw.test {
-        let where_ = format!("[[test]] id = {:?}: ", t.id);
         if t.id.trim().is_empty() {
             return Err(bad(path, "[[test]] with an empty id"));
         }
         if !seen.insert(t.id.clone()) {
-            return Err(bad(path, format!("{where_}duplicate test id")));
+            return Err(bad(path, format!("[[test]] id = {:?}: duplicate test id", t.id)));
         }
-        let nested = t.channels.clone().unwrap_or_default();
-        let time = t
-            .time
-            .clone()
-            .or(nested.time)
-            .or(defaults.time.clone())
-            .ok_or_else(|| bad(path, format!("{where_}no time channel: set [channels].time or time in this [[test]]")))?;
-        let displacement = t
-            .displacement
-            .clone()
-            .or(nested.displacement)
-            .or(defaults.displacement.clone())
-            .ok_or_else(|| {
-                bad(
-                    path,
-                    format!("{where_}no displacement channel: set [channels].displacement or displacement in this [[test]]"),
-                )
-            })?;
-        let outward_sign = sign(
-            path,
-            &where_,
-            t.outward_sign.or(nested.outward_sign).or(defaults.outward_sign).unwrap_or(1),
-        )?;
-        let sensor_h = displacement.height_m.ok_or_else(|| {
-            bad(
-                path,
-                format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"),
-            )
-        })?;
-        let sensor_h = positive(path, "displacement.height_m", sensor_h)?;
-        let lever_arm_m = sensor_h - w.hinge_height_m;
-        if lever_arm_m <= 0.0 {
-            return Err(bad(
-                path,
-                format!("{where_}sensor height {sensor_h} m is not above the hinge ({} m)", w.hinge_height_m),
-            ));
-        }
-        let format = match &t.format {
-            Some(f) => parse_format(path, &format!("{where_}format."), f)?,
-            None => campaign_format,
-        };
-        if let Some(d) = t.imposed_displacement_mm {
-            positive(path, "imposed_displacement_mm", d)?;
-        }
-        tests.push(TestSpec {
-            id: t.id.clone(),
-            file: base.join(&t.file),
-            imposed_displacement_mm: t.imposed_displacement_mm,
-            exclude_from_mean: t.exclude_from_mean,
-            time,
-            displacement,
-            outward_sign,
-            format,
-            lever_arm_m,
-        });
+        tests.push(validate_test(t, &defaults, path)?);
     }
     Ok(Campaign {
         name: raw.campaign.name,
         rocking: raw.campaign.rocking,
         manifest_path: path.to_path_buf(),
-        height_m,
-        thickness_m,
+        height_m: wall.height_m,
+        thickness_m: wall.thickness_m,
         width_m: w.width_m,
         weight_kn: w.weight_kN,
         hinge_height_m: w.hinge_height_m,
-        alpha_rad,
-        alpha_source,
-        e_housner,
-        e_housner_source,
+        alpha_rad: wall.alpha_rad,
+        alpha_source: wall.alpha_source,
+        e_housner: wall.e_housner,
+        e_housner_source: wall.e_housner_source,
         tests,
     })
 }

@@ -73,9 +73,9 @@ mod quality;
 mod segments;
 mod uncertainty;
 
-use crate::ingest::Rocking;
 use crate::signal::savgol::SavGol;
 use crate::signal::{median, noise_sigma};
+use crate::wall::Rocking;
 use segments::{FitInput, SegmentFit};
 
 /// What the estimator knows about the wall.
@@ -158,13 +158,8 @@ pub enum PeakError {
     Fit(String),
 }
 
-/// Side of the wall a segment lies on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Side {
-    Outward,
-    Inward,
-}
+/// Side of the wall a segment lies on (the one `Side` of the crate).
+pub use crate::wall::Side;
 
 /// One impact: the crossing of θ = 0 and the speeds on either side of it.
 #[derive(Debug, Clone, Copy, serde::Serialize)]

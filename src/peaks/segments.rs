@@ -22,8 +22,8 @@
 
 use super::model::{fit_model, ix, Fitted, Layout, Model};
 use super::{ContactModel, Impact, PeakError, Physics, Side};
-use crate::ingest::Rocking;
 use crate::signal::median;
+use crate::wall::Rocking;
 
 /// Result of the global fit, in the form the analysis reports.
 #[derive(Debug, Clone)]

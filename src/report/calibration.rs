@@ -23,7 +23,7 @@ pub fn calibration_files(res: &CampaignResult, cal: &Calibration, n: usize, wall
         html_sections: vec![calibration_html(cal, n, &figs)],
     };
     let mut files = Files::default();
-    files.add("calibration.toml", crate::calibrate::to_toml(cal));
+    files.add("calibration.toml", crate::calibrate::to_toml(cal)?);
     for f in &figs {
         f.figure.add_to(&mut files, &format!("plots/{}", f.stem));
     }
@@ -105,7 +105,7 @@ pub fn per_impact_table(cal: &Calibration) -> Table {
 fn calibration_html(cal: &Calibration, n: usize, figs: &[Captioned]) -> String {
     let mut s = format!(
         "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
-        if cal.rocking == "one-sided" { " and inward spring" } else { "" },
+        if cal.rocking == crate::wall::Rocking::OneSided { " and inward spring" } else { "" },
         escape(&cal.included.join(", ")),
         cal.e_in,
         cal.r_in,

@@ -81,7 +81,7 @@ struct PerImpact<'a> {
 #[derive(Serialize)]
 struct Failure<'a> {
     id: &'a str,
-    error: &'a str,
+    error: &'a crate::calibrate::TestFailure,
 }
 
 #[derive(Serialize)]

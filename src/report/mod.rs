@@ -28,6 +28,8 @@ pub enum ReportError {
     Csv(#[from] csv::Error),
     #[error("JSON: {0}")]
     Json(#[from] serde_json::Error),
+    #[error("TOML: {0}")]
+    Toml(#[from] toml::ser::Error),
     #[error("writing {path}: {source}")]
     Write { path: PathBuf, source: std::io::Error },
 }

@@ -4,10 +4,10 @@
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::Value;
 
+use crate::campaign_means::Means;
 use crate::peaks::{Impact, Peak};
 use crate::reduce::{CampaignResult, TestOutcome};
 use crate::restitution::Coefficients;
-use crate::tables::Means;
 
 /// The standard uncertainties of a test's coefficients, each key with `_u`
 /// appended (`r_plus_u` beside `r_plus`).
@@ -47,7 +47,7 @@ struct TestDoc<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
     reason: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<&'a str>,
+    error: Option<&'a crate::reduce::TestError>,
     #[serde(flatten)]
     reduction: Option<Reduction<'a>>,
     exclude_from_mean: bool,
@@ -69,7 +69,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }
-        Err(e) => ("error", None, Some(e.as_str()), None),
+        Err(e) => ("error", None, Some(e), None),
     };
     TestDoc {
         id: &t.spec.id,

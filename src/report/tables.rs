@@ -5,9 +5,9 @@
 
 pub use super::table::{to_csv, to_html, to_latex, to_markdown, Table};
 use super::table::{Align, Cell, Column, CsvField};
+use crate::campaign_means::{CampaignMeans, Means};
 use crate::reduce::CampaignResult;
 use crate::restitution::Coefficients;
-use crate::tables::{CampaignMeans, Means};
 
 /// "59%" or "59 ± 1%" (the uncertainty to one significant digit, at least 1 %
 /// resolution unless it is below 1 %).
@@ -134,7 +134,7 @@ fn layout(name: &str, caption: String, cols: Cols) -> Table {
 /// uncertainties and why the tool cannot vouch for them, or why there are none.
 pub struct TestValues<'a> {
     pub id: &'a str,
-    pub values: Result<(&'a Coefficients, Option<&'a Coefficients>, Option<String>), &'a str>,
+    pub values: Result<(&'a Coefficients, Option<&'a Coefficients>, Option<String>), String>,
 }
 
 /// What the campaign tables are built from: the captions' context (rocking,
@@ -159,7 +159,7 @@ impl<'a> CampaignView<'a> {
                     .result
                     .as_ref()
                     .map(|r| (&r.coefficients, r.uncertainty.as_ref(), r.suspect_reason()))
-                    .map_err(|e| e.as_str()),
+                    .map_err(|e| e.reason()),
             })
             .collect();
         CampaignView {
@@ -175,7 +175,10 @@ impl<'a> CampaignView<'a> {
 fn build(v: &CampaignView, name: &'static str, caption: String, cols: Cols) -> Table {
     let mut t = layout(name, caption, cols);
     for test in &v.tests {
-        t.push(Some(test.id.to_string()), test_row(cols, test.id, test.values.clone()));
+        t.push(
+            Some(test.id.to_string()),
+            test_row(cols, test.id, test.values.as_ref().cloned().map_err(|e| e.as_str())),
+        );
     }
     if t.rows.iter().any(|r| r.cells[0].tex.as_deref().is_some_and(|x| x.contains("dagger"))) {
         t.tex_note = Some("$^\\dagger$ suspect: the estimator cannot vouch for these values (left out of the mean).".into());

@@ -12,6 +12,15 @@
 use nalgebra::DMatrix;
 
 /// Validated Savitzky–Golay settings.
+/// A window or an order that no Savitzky–Golay filter has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum SavGolError {
+    #[error("Savitzky–Golay window {window}: expected an odd number ≥ 3")]
+    Window { window: usize },
+    #[error("Savitzky–Golay order {order}: expected an order below the window ({window})")]
+    Order { order: usize, window: usize },
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SavGol {
     half_window: usize,
@@ -20,12 +29,12 @@ pub struct SavGol {
 
 impl SavGol {
     /// `window` odd and ≥ 3, `order` < `window`.
-    pub fn new(window: usize, order: usize) -> Result<SavGol, String> {
+    pub fn new(window: usize, order: usize) -> Result<SavGol, SavGolError> {
         if window < 3 || window % 2 == 0 {
-            return Err(format!("Savitzky–Golay window {window}: expected an odd number ≥ 3"));
+            return Err(SavGolError::Window { window });
         }
         if order >= window {
-            return Err(format!("Savitzky–Golay order {order}: expected an order below the window ({window})"));
+            return Err(SavGolError::Order { order, window });
         }
         Ok(SavGol {
             half_window: window / 2,

@@ -1,5 +1,7 @@
 //! A rigid rocking block: geometry → R, α, m, I_0 and p² (with overrides).
 
+use super::model::{Restraint, TieRod};
+use crate::wall::Rectangle;
 use crate::G;
 
 /// The block's dynamic properties.
@@ -16,17 +18,22 @@ pub struct Block {
 }
 
 impl Block {
-    /// Rectangular block of height h, thickness b, width w and unit weight γ
-    /// (kN/m³): R = ½√(h² + b²), α = atan(b/h), m = γ h b w / g, I_0 = 4/3 m R².
-    pub fn rectangular(height_m: f64, thickness_m: f64, width_m: f64, unit_weight_kn_m3: f64) -> Block {
-        let r = 0.5 * height_m.hypot(thickness_m);
-        let mass = unit_weight_kn_m3 * 1e3 * height_m * thickness_m * width_m / G;
+    /// Rectangular block `geom` (height h, thickness b) of width w and unit weight
+    /// γ (kN/m³): R = ½√(h² + b²), α = atan(b/h), m = γ h b w / g, I_0 = 4/3 m R².
+    pub fn rectangular(geom: Rectangle, width_m: f64, unit_weight_kn_m3: f64) -> Block {
+        let r = geom.half_diagonal();
+        let mass = unit_weight_kn_m3 * 1e3 * geom.height_m * geom.thickness_m * width_m / G;
         Block {
             r_m: r,
-            alpha: (thickness_m / height_m).atan(),
+            alpha: geom.slenderness(),
             mass_kg: mass,
-            i0: 4.0 / 3.0 * mass * r * r,
+            i0: Block::rectangular_i0(mass, r),
         }
+    }
+
+    /// I_0 = 4/3 m R² of a rectangular block of mass m and half-diagonal R.
+    pub fn rectangular_i0(mass_kg: f64, r_m: f64) -> f64 {
+        4.0 / 3.0 * mass_kg * r_m * r_m
     }
 
     /// p² = m g R / I_0 (s⁻²); 3g/(4R) for a rectangular block.
@@ -35,13 +42,39 @@ impl Block {
     }
 }
 
+/// A rocking wall for the solver: the block, the inward restraint, the tie-rods
+/// and the impact defaults (read from a block file by `rocklab::ingest::block`).
+#[derive(Debug, Clone)]
+pub struct BlockSpec {
+    pub name: String,
+    pub block: Block,
+    pub restraint: Restraint,
+    pub ties: Vec<TieRod>,
+    pub impact: ImpactDefaults,
+    /// (K'_c in MN/m², contact height in m) when the restraint is given as a
+    /// spring bed (the façade ensembles vary them).
+    pub spring_bed: Option<(f64, f64)>,
+    /// Which of R, α, I_0, mass were overridden.
+    pub overrides: Vec<String>,
+}
+
+/// Optional impact defaults of a block file.
+#[derive(Debug, Clone, Copy, Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactDefaults {
+    pub e: Option<f64>,
+    pub e_in: Option<f64>,
+    pub e_out: Option<f64>,
+    pub overturn_limit_rad: Option<f64>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn rectangular_p2_is_3g_over_4r() {
-        let b = Block::rectangular(7.64, 0.80, 12.0, 18.0);
+        let b = Block::rectangular(Rectangle::new(7.64, 0.80), 12.0, 18.0);
         assert!((b.p2() - 3.0 * G / (4.0 * b.r_m)).abs() < 1e-12);
         assert!((b.r_m - 3.8409).abs() < 1e-4);
         assert!((b.alpha - 0.10437).abs() < 1e-4);

@@ -14,6 +14,6 @@ pub mod integrator;
 pub mod model;
 pub mod run;
 
-pub use block::Block;
+pub use block::{Block, BlockSpec};
 pub use model::{Ground, Restraint, RockingModel, TieRod};
 pub use run::{simulate, simulate_at, Event, Settings, Simulation, Stop};

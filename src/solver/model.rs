@@ -15,6 +15,7 @@
 //! - Ground acceleration ü_g: record × magnification × polarity, linear between
 //!   samples.
 
+use crate::wall::Side;
 use crate::G;
 
 /// The inward restraint by the transverse walls.
@@ -112,10 +113,11 @@ pub struct RockingModel {
 }
 
 impl RockingModel {
-    /// θ'' for side s (±1), rotation θ, rate ω, ground acceleration a (m/s²) and
+    /// θ'' on pivot `side` (s = ±1), rotation θ, ground acceleration a (m/s²) and
     /// the tie-rods' plastic elongations.
     #[inline]
-    pub fn accel(&self, s: f64, theta: f64, a: f64, plastic: &[f64]) -> f64 {
+    pub fn accel(&self, side: Side, theta: f64, a: f64, plastic: &[f64]) -> f64 {
+        let s = side.sign();
         let x = self.alpha - s * theta;
         let (sn, cs) = if self.linearized { (x, 1.0) } else { x.sin_cos() };
         let mut acc = -self.p2 * s * sn + self.p2 / G * a * cs;
@@ -163,9 +165,10 @@ impl RockingModel {
         G * self.alpha.tan()
     }
 
-    /// Whether rotation θ on side s is past the overturning limit.
-    pub fn overturn_level(&self, s: f64) -> Option<f64> {
-        if s > 0.0 {
+    /// The overturning level of θ on pivot `side` (None: the inward side of a
+    /// restrained wall, which cannot overturn inward).
+    pub fn overturn_level(&self, side: Side) -> Option<f64> {
+        if side == Side::Outward {
             Some(self.overturn_limit)
         } else if matches!(self.restraint, Restraint::None) {
             Some(-self.overturn_limit)

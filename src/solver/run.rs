@@ -5,6 +5,22 @@
 
 use super::integrator::{find_root, next_h, step, Dense, State, Tolerances};
 use super::model::{Ground, RockingModel};
+use crate::wall::Side;
+
+/// Settings, an initial state or a record the solver cannot run with.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolverError {
+    #[error("tolerances rtol = {rtol}, atol = {atol}: expected positive numbers")]
+    Tolerances { rtol: f64, atol: f64 },
+    #[error("{what} = {value}: expected a positive number")]
+    NotPositive { what: &'static str, value: f64 },
+    #[error("end time t_end = {t_end}: expected a finite number")]
+    EndTime { t_end: f64 },
+    #[error("initial state (θ, θ') = ({theta}, {omega}): expected finite numbers")]
+    Initial { theta: f64, omega: f64 },
+    #[error("ground motion: time step dt = {dt} and start t0 = {t0}: expected dt > 0 and finite t0")]
+    Ground { dt: f64, t0: f64 },
+}
 
 /// Settings of a run; defaults: rtol 1e-9, atol 1e-12, rest below 1e-7 rad/s,
 /// history kept, steps at most 10 ms.
@@ -34,10 +50,35 @@ impl Settings {
             stop_at_rest: true,
         }
     }
+    /// Relative and absolute tolerances (checked by [`Settings::validate`]).
     pub fn with_tolerances(mut self, rtol: f64, atol: f64) -> Settings {
-        assert!(rtol > 0.0 && atol > 0.0, "tolerances must be positive");
         self.tol = Tolerances { rtol, atol };
         self
+    }
+
+    /// Every setting usable: positive tolerances, step and rest speed ≥ 0, a
+    /// finite end. [`simulate`] checks it before it runs.
+    pub fn validate(&self) -> Result<(), SolverError> {
+        let Tolerances { rtol, atol } = self.tol;
+        if !(rtol > 0.0 && atol > 0.0 && rtol.is_finite() && atol.is_finite()) {
+            return Err(SolverError::Tolerances { rtol, atol });
+        }
+        if self.max_step.is_nan() || self.max_step <= 0.0 {
+            return Err(SolverError::NotPositive {
+                what: "max_step",
+                value: self.max_step,
+            });
+        }
+        if self.rest_speed.is_nan() || self.rest_speed < 0.0 {
+            return Err(SolverError::NotPositive {
+                what: "rest_speed",
+                value: self.rest_speed,
+            });
+        }
+        if self.t_end.is_nan() || self.t_end.is_infinite() {
+            return Err(SolverError::EndTime { t_end: self.t_end });
+        }
+        Ok(())
     }
     pub fn without_history(mut self) -> Settings {
         self.keep_history = false;
@@ -55,17 +96,19 @@ impl Settings {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Event {
-    /// θ crossed 0; `entering` is +1 (outward side) or −1 (inward side).
+    /// θ crossed 0 into side `entering` (serialised +1 outward, −1 inward).
     Impact {
         t: f64,
-        entering: i8,
+        #[serde(serialize_with = "Side::serialize_as_sign")]
+        entering: Side,
         v_before: f64,
         v_after: f64,
     },
-    /// Rocking started from rest towards `side`.
+    /// Rocking started from rest towards `side` (serialised ±1).
     Uplift {
         t: f64,
-        side: i8,
+        #[serde(serialize_with = "Side::serialize_as_sign")]
+        side: Side,
     },
     /// The impacts took the speed below the rest threshold.
     Rest {
@@ -105,9 +148,11 @@ pub struct Simulation {
     pub steps: usize,
 }
 
+/// At rest, or rocking on a pivot.
+#[derive(Debug, Clone, Copy)]
 enum Phase {
     Rest,
-    Rocking(f64),
+    Rocking(Side),
 }
 
 /// θ at requested output times, filled as the run advances (dense output inside
@@ -128,8 +173,8 @@ impl Outputs<'_> {
 }
 
 /// Run the model from `t0`, at rest unless `initial` = (θ0, θ0') is given.
-pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings) -> Simulation {
-    simulate_at(model, ground, t0, initial, settings, &[]).0
+pub fn simulate(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings) -> Result<Simulation, SolverError> {
+    simulate_at(model, ground, t0, initial, settings, &[]).map(|r| r.0)
 }
 
 /// As [`simulate`], and θ at the sorted `outputs` times (before `t0`: the initial θ).
@@ -140,7 +185,17 @@ pub fn simulate_at(
     initial: Option<State>,
     settings: &Settings,
     outputs: &[f64],
-) -> (Simulation, Vec<f64>) {
+) -> Result<(Simulation, Vec<f64>), SolverError> {
+    settings.validate()?;
+    if let Some([theta, omega]) = initial.filter(|s| !(s[0].is_finite() && s[1].is_finite())) {
+        return Err(SolverError::Initial { theta, omega });
+    }
+    if !(ground.dt > 0.0 && ground.t0.is_finite()) {
+        return Err(SolverError::Ground {
+            dt: ground.dt,
+            t0: ground.t0,
+        });
+    }
     let mut out = Outputs {
         times: outputs,
         values: Vec::with_capacity(outputs.len()),
@@ -155,158 +210,246 @@ pub fn simulate_at(
         None => out.values.last().copied().unwrap_or(th0),
     };
     out.fill(f64::INFINITY, |_| fill_value);
-    (sim, out.values)
+    Ok((sim, out.values))
 }
 
+/// The event loop: [`Loop::step`] until it says the run stopped.
 fn simulate_inner(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings, out: &mut Outputs) -> Simulation {
-    let mut sim = Simulation {
-        stop: Stop::End,
-        events: Vec::new(),
-        history: Vec::new(),
-        max_theta: 0.0,
-        min_theta: 0.0,
-        impacts: 0,
-        steps: 0,
-    };
-    let mut plastic = vec![0.0; model.ties.len()];
-    let mut t = t0;
-    let mut y: State = initial.unwrap_or([0.0, 0.0]);
-    let mut phase = match initial {
-        Some([th, om]) if th != 0.0 || om != 0.0 => Phase::Rocking(if th != 0.0 { th.signum() } else { om.signum() }),
-        _ => Phase::Rest,
-    };
-    let thr = model.uplift_threshold();
-    // After `quiet`, |ü_g| ≤ threshold everywhere (found on the first rest).
-    let mut quiet: Option<f64> = None;
-    let mut h = 1e-3f64.min(settings.max_step);
-    let push = |sim: &mut Simulation, t: f64, y: &State| {
-        sim.max_theta = sim.max_theta.max(y[0]);
-        sim.min_theta = sim.min_theta.min(y[0]);
-        if settings.keep_history {
-            sim.history.push(Sample {
+    let mut run = Loop::new(model, ground, t0, initial, settings, out);
+    loop {
+        if let StepOutcome::Stopped(stop) = run.step() {
+            run.sim.stop = stop;
+            return run.sim;
+        }
+    }
+}
+
+/// What one [`Loop::step`] did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum StepOutcome {
+    /// An accepted integration step, or a move onto the next record sample.
+    Advanced,
+    /// A step rejected (error above tolerance, or a hop hidden inside it): it is
+    /// retried smaller.
+    Rejected,
+    /// An impact (rocking goes on from the other pivot, or the wall came to rest).
+    Impact,
+    /// The wall left rest.
+    Uplift,
+    /// The run is over: the end time reached, or the wall overturned.
+    Stopped(Stop),
+}
+
+/// The state of the event loop between steps.
+struct Loop<'a, 'o> {
+    model: &'a RockingModel,
+    ground: &'a Ground,
+    settings: &'a Settings,
+    out: &'a mut Outputs<'o>,
+    sim: Simulation,
+    /// Plastic elongations of the tie-rods.
+    plastic: Vec<f64>,
+    t: f64,
+    y: State,
+    phase: Phase,
+    /// The derivative at (t, y) carried over from the last accepted step (FSAL) or
+    /// the last record sample; None: evaluate it afresh.
+    k1: Option<State>,
+    /// The step size to try next.
+    h: f64,
+    /// |ü_g| above which the wall uplifts from rest.
+    threshold: f64,
+    /// After this time |ü_g| ≤ threshold everywhere (found on the first rest).
+    quiet: Option<f64>,
+}
+
+impl<'a, 'o> Loop<'a, 'o> {
+    fn new(model: &'a RockingModel, ground: &'a Ground, t0: f64, initial: Option<State>, settings: &'a Settings, out: &'a mut Outputs<'o>) -> Self {
+        let phase = match initial {
+            Some([th, om]) if th != 0.0 || om != 0.0 => Phase::Rocking(Side::of(if th != 0.0 { th } else { om })),
+            _ => Phase::Rest,
+        };
+        let mut run = Loop {
+            model,
+            ground,
+            settings,
+            out,
+            sim: Simulation {
+                stop: Stop::End,
+                events: Vec::new(),
+                history: Vec::new(),
+                max_theta: 0.0,
+                min_theta: 0.0,
+                impacts: 0,
+                steps: 0,
+            },
+            plastic: vec![0.0; model.ties.len()],
+            t: t0,
+            y: initial.unwrap_or([0.0, 0.0]),
+            phase,
+            k1: None,
+            h: 1e-3f64.min(settings.max_step),
+            threshold: model.uplift_threshold(),
+            quiet: None,
+        };
+        run.push(t0, run.y);
+        run
+    }
+
+    /// Record a point: the extremes, and the history when kept.
+    fn push(&mut self, t: f64, y: State) {
+        self.sim.max_theta = self.sim.max_theta.max(y[0]);
+        self.sim.min_theta = self.sim.min_theta.min(y[0]);
+        if self.settings.keep_history {
+            self.sim.history.push(Sample {
                 t,
                 theta: y[0],
                 omega: y[1],
-                ag: ground.at(t),
+                ag: self.ground.at(t),
             });
         }
-    };
-    push(&mut sim, t, &y);
-    while t < settings.t_end {
-        match phase {
-            Phase::Rest => {
-                y = [0.0, 0.0];
-                let q = *quiet.get_or_insert_with(|| quiet_after(ground, thr));
-                let next = if settings.stop_at_rest && t >= q {
-                    None
-                } else {
-                    next_uplift(ground, t, settings.t_end, thr)
-                };
-                out.fill(next.map_or(settings.t_end, |n| n.0), |_| 0.0);
-                match next {
-                    Some((tu, side)) => {
-                        if tu > t {
-                            push(&mut sim, tu, &y);
-                        }
-                        t = tu;
-                        sim.events.push(Event::Uplift { t, side: side as i8 });
-                        phase = Phase::Rocking(side);
-                    }
-                    None => {
-                        t = settings.t_end;
-                        push(&mut sim, t, &y);
-                        break;
-                    }
+    }
+
+    /// One step of the loop, and what it did.
+    fn step(&mut self) -> StepOutcome {
+        if self.t >= self.settings.t_end {
+            return StepOutcome::Stopped(Stop::End);
+        }
+        match self.phase {
+            Phase::Rest => self.rest(),
+            Phase::Rocking(side) => self.rock(side),
+        }
+    }
+
+    /// At rest: jump to the next uplift (or to the end: nothing uplifts the wall
+    /// before it, or nothing can any more once the record is quiet).
+    fn rest(&mut self) -> StepOutcome {
+        let (ground, settings) = (self.ground, self.settings);
+        self.y = [0.0, 0.0];
+        let thr = self.threshold;
+        let q = *self.quiet.get_or_insert_with(|| quiet_after(ground, thr));
+        let next = if settings.stop_at_rest && self.t >= q {
+            None
+        } else {
+            next_uplift(ground, self.t, settings.t_end, thr)
+        };
+        self.out.fill(next.map_or(settings.t_end, |n| n.0), |_| 0.0);
+        match next {
+            Some((tu, side)) => {
+                if tu > self.t {
+                    self.push(tu, self.y);
                 }
+                self.t = tu;
+                self.sim.events.push(Event::Uplift { t: tu, side });
+                self.phase = Phase::Rocking(side);
+                self.k1 = None;
+                StepOutcome::Uplift
             }
-            Phase::Rocking(s) => {
-                let mut k1: State = [y[1], model.accel(s, y[0], ground.at(t), &plastic)];
-                loop {
-                    let pl = &plastic;
-                    // The step never crosses a record sample, so ü_g is linear on it.
-                    let (ta, a0, slope) = ground.linear_piece(t);
-                    let mut f = |tt: f64, yy: &State| -> State { [yy[1], model.accel(s, yy[0], a0 + slope * (tt - ta), pl)] };
-                    let boundary = next_sample_after(ground, t).min(settings.t_end);
-                    let hh = h.min(boundary - t).min(settings.max_step);
-                    if hh <= 1e-14 * t.abs().max(1.0) {
-                        // At a boundary: move on to it exactly.
-                        t = boundary;
-                        if t >= settings.t_end {
-                            break;
-                        }
-                        k1 = f(t, &y);
-                        continue;
-                    }
-                    let st = step(&mut f, t, &y, &k1, hh, settings.tol);
-                    sim.steps += 1;
-                    if st.err > 1.0 {
-                        h = next_h(hh, st.err).max(1e-12);
-                        continue;
-                    }
-                    // A step that ends on the wrong side without a detected crossing
-                    // hid a short hop: retry smaller.
-                    let ev = first_event(model, s, &st.dense, t, hh, &y);
-                    if ev.is_none() && s * st.y1[0] < 0.0 {
-                        h = 0.25 * hh;
-                        continue;
-                    }
-                    track_extremum(&mut sim, &st.dense, t, hh, &y, &st.y1);
-                    let dense = st.dense;
-                    out.fill(ev.map_or(t + hh, |e| e.0), |x| dense.at(x)[0]);
-                    match ev {
-                        None => {
-                            t += hh;
-                            y = st.y1;
-                            k1 = st.k7;
-                            model.update_plastic(y[0], &mut plastic);
-                            push(&mut sim, t, &y);
-                            h = next_h(hh, st.err);
-                            if t >= settings.t_end {
-                                break;
-                            }
-                        }
-                        Some((te, EventKind::Overturn)) => {
-                            let ye = st.dense.at(te);
-                            push(&mut sim, te, &ye);
-                            sim.events.push(Event::Overturned { t: te });
-                            sim.stop = Stop::Overturned { t: te };
-                            return sim;
-                        }
-                        Some((te, EventKind::Impact)) => {
-                            let ye = st.dense.at(te);
-                            let vb = ye[1];
-                            let entering = -s;
-                            let e = if entering < 0.0 { model.e_in } else { model.e_out };
-                            let va = e * vb;
-                            push(&mut sim, te, &[0.0, vb]);
-                            sim.impacts += 1;
-                            sim.events.push(Event::Impact {
-                                t: te,
-                                entering: entering as i8,
-                                v_before: vb,
-                                v_after: va,
-                            });
-                            t = te;
-                            y = [0.0, va];
-                            h = hh.max(1e-6);
-                            if va.abs() < settings.rest_speed {
-                                sim.events.push(Event::Rest { t });
-                                phase = Phase::Rest;
-                            } else {
-                                phase = Phase::Rocking(entering);
-                            }
-                            push(&mut sim, t, &y);
-                            break;
-                        }
-                    }
-                }
-                if t >= settings.t_end {
-                    break;
-                }
+            None => {
+                self.t = settings.t_end;
+                self.push(self.t, self.y);
+                StepOutcome::Stopped(Stop::End)
             }
         }
     }
-    sim
+
+    /// Rocking on pivot `side`: one trial step of the integrator, never past the
+    /// next record sample (ü_g is linear on it), and the event it holds.
+    fn rock(&mut self, side: Side) -> StepOutcome {
+        let (model, ground, settings) = (self.model, self.ground, self.settings);
+        let (t, y) = (self.t, self.y);
+        let k1 = match self.k1 {
+            Some(k) => k,
+            None => [y[1], model.accel(side, y[0], ground.at(t), &self.plastic)],
+        };
+        let pl = &self.plastic;
+        let (ta, a0, slope) = ground.linear_piece(t);
+        let mut f = |tt: f64, yy: &State| -> State { [yy[1], model.accel(side, yy[0], a0 + slope * (tt - ta), pl)] };
+        let boundary = next_sample_after(ground, t).min(settings.t_end);
+        let hh = self.h.min(boundary - t).min(settings.max_step);
+        if hh <= 1e-14 * t.abs().max(1.0) {
+            // At a boundary: move on to it exactly.
+            self.t = boundary;
+            if boundary >= settings.t_end {
+                return StepOutcome::Stopped(Stop::End);
+            }
+            self.k1 = Some(f(boundary, &y));
+            return StepOutcome::Advanced;
+        }
+        let st = step(&mut f, t, &y, &k1, hh, settings.tol);
+        self.sim.steps += 1;
+        self.k1 = Some(k1);
+        if st.err > 1.0 {
+            self.h = next_h(hh, st.err).max(1e-12);
+            return StepOutcome::Rejected;
+        }
+        // A step that ends on the wrong side without a detected crossing hid a
+        // short hop: retry smaller.
+        let s = side.sign();
+        let ev = first_event(model, side, &st.dense, t, hh, &y);
+        if ev.is_none() && s * st.y1[0] < 0.0 {
+            self.h = 0.25 * hh;
+            return StepOutcome::Rejected;
+        }
+        track_extremum(&mut self.sim, &st.dense, t, hh, &y, &st.y1);
+        let dense = &st.dense;
+        self.out.fill(ev.map_or(t + hh, |e| e.0), |x| dense.at(x)[0]);
+        match ev {
+            None => {
+                self.t = t + hh;
+                self.y = st.y1;
+                self.k1 = Some(st.k7);
+                model.update_plastic(self.y[0], &mut self.plastic);
+                self.push(self.t, self.y);
+                self.h = next_h(hh, st.err);
+                if self.t >= settings.t_end {
+                    StepOutcome::Stopped(Stop::End)
+                } else {
+                    StepOutcome::Advanced
+                }
+            }
+            Some((te, EventKind::Overturn)) => {
+                self.push(te, st.dense.at(te));
+                self.sim.events.push(Event::Overturned { t: te });
+                StepOutcome::Stopped(Stop::Overturned { t: te })
+            }
+            Some((te, EventKind::Impact)) => {
+                self.impact(side, te, st.dense.at(te)[1], hh);
+                StepOutcome::Impact
+            }
+        }
+    }
+
+    /// An impact at `te` with θ' = `vb` coming from pivot `from`: θ' ← e θ' with
+    /// the coefficient of the side entered; rest when that leaves the wall slower
+    /// than the rest speed.
+    fn impact(&mut self, from: Side, te: f64, vb: f64, hh: f64) {
+        let entering = from.opposite();
+        let e = match entering {
+            Side::Inward => self.model.e_in,
+            Side::Outward => self.model.e_out,
+        };
+        let va = e * vb;
+        self.push(te, [0.0, vb]);
+        self.sim.impacts += 1;
+        self.sim.events.push(Event::Impact {
+            t: te,
+            entering,
+            v_before: vb,
+            v_after: va,
+        });
+        self.t = te;
+        self.y = [0.0, va];
+        self.h = hh.max(1e-6);
+        self.k1 = None;
+        if va.abs() < self.settings.rest_speed {
+            self.sim.events.push(Event::Rest { t: te });
+            self.phase = Phase::Rest;
+        } else {
+            self.phase = Phase::Rocking(entering);
+        }
+        self.push(te, self.y);
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -318,8 +461,9 @@ enum EventKind {
 /// The first event inside an accepted step: θ returning to 0 from side s, or θ
 /// reaching the overturning level. The dense output is sampled at 8 points so
 /// that a short excursion inside one step is not missed.
-fn first_event(model: &RockingModel, s: f64, d: &Dense, t: f64, h: f64, y0: &State) -> Option<(f64, EventKind)> {
-    let level = model.overturn_level(s);
+fn first_event(model: &RockingModel, side: Side, d: &Dense, t: f64, h: f64, y0: &State) -> Option<(f64, EventKind)> {
+    let level = model.overturn_level(side);
+    let s = side.sign();
     // Quick exclusion: on the step θ stays within h·(|ω₀| + |ω₁|) + h²·(|θ''|max)
     // of its end values (Taylor bound; |θ''| taken generously from the change of ω
     // across the step plus p²), so a step far from 0 and from the limit holds no event.
@@ -369,44 +513,44 @@ fn track_extremum(sim: &mut Simulation, d: &Dense, t: f64, h: f64, y0: &State, y
 }
 
 /// The first record sample strictly after t (or +∞ past the record).
-fn next_sample_after(g: &Ground, t: f64) -> f64 {
-    if g.acc.len() < 2 || t >= g.end() {
+fn next_sample_after(ground: &Ground, t: f64) -> f64 {
+    if ground.acc.len() < 2 || t >= ground.end() {
         return f64::INFINITY;
     }
-    if t < g.t0 {
-        return g.t0;
+    if t < ground.t0 {
+        return ground.t0;
     }
-    let k = ((t - g.t0) / g.dt * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
-    g.t0 + g.dt * k
+    let k = ((t - ground.t0) / ground.dt * (1.0 + 1e-12) + 1e-9).floor() + 1.0;
+    ground.t0 + ground.dt * k
 }
 
 /// The time after which |ü_g| ≤ threshold for good: the end of the interval after
 /// the last sample above it (ü_g is linear between samples, so it can only exceed
 /// the threshold next to such a sample); the record's start if none is.
-fn quiet_after(g: &Ground, thr: f64) -> f64 {
-    match g.acc.iter().rposition(|a| a.abs() > thr) {
-        Some(i) => g.time((i + 1).min(g.acc.len().saturating_sub(1))),
-        None => g.t0,
+fn quiet_after(ground: &Ground, thr: f64) -> f64 {
+    match ground.acc.iter().rposition(|a| a.abs() > thr) {
+        Some(i) => ground.time((i + 1).min(ground.acc.len().saturating_sub(1))),
+        None => ground.t0,
     }
 }
 
 /// Next time ≥ t when |ü_g| exceeds the threshold (exact on the piecewise-linear
-/// record), and the side (sign of ü_g).
-fn next_uplift(g: &Ground, t: f64, t_end: f64, thr: f64) -> Option<(f64, f64)> {
-    let a_now = g.at(t);
+/// record), and the side the wall rocks towards (the sign of ü_g).
+fn next_uplift(ground: &Ground, t: f64, t_end: f64, thr: f64) -> Option<(f64, Side)> {
+    let a_now = ground.at(t);
     if a_now.abs() > thr {
-        return Some((t, a_now.signum()));
+        return Some((t, Side::of(a_now)));
     }
-    if g.acc.len() < 2 || t >= g.end() {
+    if ground.acc.len() < 2 || t >= ground.end() {
         return None;
     }
-    let start = g.interval(t.max(g.t0));
-    for i in start..g.acc.len() - 1 {
-        let (ta, tb) = (g.time(i), g.time(i + 1));
+    let start = ground.interval(t.max(ground.t0));
+    for i in start..ground.acc.len() - 1 {
+        let (ta, tb) = (ground.time(i), ground.time(i + 1));
         if ta > t_end {
             return None;
         }
-        let (a, b) = (g.acc[i], g.acc[i + 1]);
+        let (a, b) = (ground.acc[i], ground.acc[i + 1]);
         for sgn in [1.0, -1.0] {
             let (fa, fb) = (sgn * a - thr, sgn * b - thr);
             if fb > 0.0 && fa <= 0.0 {
@@ -415,7 +559,7 @@ fn next_uplift(g: &Ground, t: f64, t_end: f64, thr: f64) -> Option<(f64, f64)> {
                 if tc <= t_end {
                     // Just past the crossing, so that |ü_g| > threshold strictly.
                     let tu = (tc + 1e-12).min(tb);
-                    return Some((tu, sgn));
+                    return Some((tu, Side::of(sgn)));
                 }
                 return None;
             }

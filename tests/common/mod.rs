@@ -68,7 +68,7 @@ pub fn synthetic_log(s: &LogSpec) -> (String, Vec<f64>) {
     };
     let mut settings = Settings::new(duration).with_tolerances(1e-11, 1e-14);
     settings.rest_speed = 1e-9;
-    let (sim, th) = simulate_at(&model, &ground, t_r, Some([theta0, 0.0]), &settings, &t);
+    let (sim, th) = simulate_at(&model, &ground, t_r, Some([theta0, 0.0]), &settings, &t).expect("valid settings");
     let peaks = sim
         .events
         .iter()

@@ -1,4 +1,4 @@
-//! Campaign tables (paper Tables 1–3) and their means, which leave out the tests
+//! The campaign means of the ratios (the mean rows of paper Tables 1–3), which leave out the tests
 //! flagged `exclude_from_mean` and the tests that could not be reduced, and say so.
 
 use crate::restitution::Coefficients;

@@ -1,33 +1,54 @@
-//! The per-test reduction pipeline: read the log, find the release, impacts and
-//! velocity peaks, compute the coefficients. One `Result` per test, so one broken
-//! test never stops the others.
+//! A campaign's reduction from its files: read each log as its manifest entry says,
+//! reduce it in memory ([`crate::reduction`]), compute the means
+//! ([`crate::campaign_means`]). One `Result` per test, so one broken test never
+//! stops the others. Re-exported at the crate root as `rocklab::reduce`.
+
+use std::path::PathBuf;
 
 use rayon::prelude::*;
 
+use crate::campaign_means::{campaign_means, CampaignMeans, Row};
+use crate::error::InputError;
 use crate::ingest::manifest::{Campaign, TestSpec};
-use crate::ingest::{LogData, LogReader};
-use crate::peaks::{analyse, Analysis, ContactModel, Method, PeakOptions, Physics};
-use crate::restitution::{coefficients, uncertainties, Coefficients};
-use crate::tables::{campaign_means, CampaignMeans, Row};
+use crate::ingest::LogReader;
+use crate::peaks::{Analysis, ContactModel, Method, PeakOptions, Physics};
+pub use crate::reduction::{LogData, ReduceError, Reduced};
 
-/// A reduced test.
-#[derive(Debug, Clone)]
-pub struct Reduced {
-    pub log: LogData,
-    pub analysis: Analysis,
-    pub coefficients: Coefficients,
-    /// Standard uncertainty of every value (propagated from the peaks' covariance;
-    /// default estimator only).
-    pub uncertainty: Option<Coefficients>,
+/// Why a test of a campaign has no coefficients.
+#[derive(Debug, thiserror::Error)]
+pub enum TestError {
+    /// The log could not be read (file, line and column in the error).
+    #[error(transparent)]
+    Read(#[from] InputError),
+    /// The log was read but could not be reduced.
+    #[error("{}: {source}", file.display())]
+    Reduce {
+        file: PathBuf,
+        #[source]
+        source: ReduceError,
+    },
 }
 
-impl Reduced {
-    /// Why the tool cannot vouch for this test's numbers, if it cannot.
-    pub fn suspect_reason(&self) -> Option<String> {
-        match &self.analysis.quality {
-            crate::peaks::Quality::Ok => None,
-            crate::peaks::Quality::Suspect(r) => Some(r.join("; ")),
+impl TestError {
+    /// The reason without the file's path when the whole file is at fault (a table
+    /// cell names the test already); a located read error keeps its line and column.
+    pub fn reason(&self) -> String {
+        match self {
+            TestError::Reduce { source, .. } => source.to_string(),
+            TestError::Read(e @ (InputError::At { .. } | InputError::Line { .. } | InputError::NoData { .. })) => e.to_string(),
+            TestError::Read(e) => {
+                let full = e.to_string();
+                let file = e.file().display().to_string();
+                full.strip_prefix(&format!("{file}: ")).map_or(full.clone(), str::to_string)
+            }
         }
+    }
+}
+
+impl serde::Serialize for TestError {
+    /// As its message (summary.json: `"error": "…"`).
+    fn serialize<S: serde::Serializer>(&self, ser: S) -> Result<S::Ok, S::Error> {
+        ser.collect_str(self)
     }
 }
 
@@ -35,7 +56,7 @@ impl Reduced {
 #[derive(Debug)]
 pub struct TestOutcome {
     pub spec: TestSpec,
-    pub result: Result<Reduced, String>,
+    pub result: Result<Reduced, TestError>,
     /// Warnings raised while reading (kept even when the reduction failed later).
     pub warnings: Vec<String>,
 }
@@ -50,30 +71,43 @@ pub struct CampaignResult {
 }
 
 impl CampaignResult {
-    pub fn failed(&self) -> impl Iterator<Item = (&str, &str)> {
-        self.tests
-            .iter()
-            .filter_map(|t| t.result.as_ref().err().map(|e| (t.spec.id.as_str(), e.as_str())))
+    /// (id, why) of every test that has no coefficients.
+    pub fn failed(&self) -> impl Iterator<Item = (&str, &TestError)> {
+        self.tests.iter().filter_map(|t| t.result.as_ref().err().map(|e| (t.spec.id.as_str(), e)))
+    }
+
+    /// The campaign as the calibration takes it (no paths, no file types).
+    pub fn calibration_input(&self) -> crate::calibrate::CampaignInput<'_> {
+        crate::calibrate::CampaignInput {
+            name: &self.campaign.name,
+            rocking: self.campaign.rocking,
+            wall: self.campaign.wall(),
+            tests: self
+                .tests
+                .iter()
+                .map(|t| crate::calibrate::TestInput {
+                    id: &t.spec.id,
+                    exclude_from_mean: t.spec.exclude_from_mean,
+                    lever_arm_m: t.spec.lever_arm_m,
+                    reduced: t.result.as_ref().map_err(|e| e as &(dyn std::error::Error + Sync)),
+                })
+                .collect(),
+        }
     }
 }
 
 /// The physics the estimator starts from, for one test of a campaign.
 pub fn physics(campaign: &Campaign, spec: &TestSpec) -> Physics {
-    Physics {
-        rocking: campaign.rocking,
-        lever_arm_mm: spec.lever_arm_m * 1e3,
-        p_guess: campaign.p_squared().sqrt(),
-    }
+    crate::reduction::physics(campaign.rocking, &campaign.wall(), spec.lever_arm_m)
 }
 
 /// Read one log as its manifest entry says.
-pub fn read_log(spec: &TestSpec) -> Result<LogData, String> {
+pub fn read_log(spec: &TestSpec) -> Result<LogData, InputError> {
     LogReader::new(&spec.file)
         .format(spec.format)
         .time(&spec.time.column, spec.time.unit.to_s())
         .displacement(&spec.displacement.column, spec.displacement.unit.to_mm() * spec.outward_sign)
         .read()
-        .map_err(|e| e.to_string())
 }
 
 /// Reduce one test: [`read_log`], then [`reduce_loaded`].
@@ -82,7 +116,7 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
         Ok(log) => reduce_loaded(campaign, spec, log, options),
         Err(e) => TestOutcome {
             spec: spec.clone(),
-            result: Err(e),
+            result: Err(e.into()),
             warnings: Vec::new(),
         },
     }
@@ -93,23 +127,10 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 /// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
 pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
     let warnings = log.warnings.clone();
-    let file = spec.file.display().to_string();
-    let result = analyse(&log.time_s, &log.disp_mm, &physics(campaign, spec), options)
-        .map_err(|e| format!("{file}: {e}"))
-        .and_then(|analysis| {
-            let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
-            let c = coefficients(&v, campaign.e_housner).ok_or_else(|| format!("{file}: too few peaks (n = {} < 6)", v.len()))?;
-            let u = analysis
-                .peak_covariance
-                .as_ref()
-                .and_then(|cov| uncertainties(&v, cov, campaign.e_housner));
-            Ok(Reduced {
-                log,
-                analysis,
-                coefficients: c,
-                uncertainty: u,
-            })
-        });
+    let result = crate::reduction::reduce_log(log, &physics(campaign, spec), campaign.e_housner, options).map_err(|source| TestError::Reduce {
+        file: spec.file.clone(),
+        source,
+    });
     TestOutcome {
         spec: spec.clone(),
         result,

@@ -1,0 +1,76 @@
+//! One test's reduction, in memory: the velocity peaks of its log (the estimator,
+//! [`crate::peaks`]), then the coefficients (paper Eqs. 3–6, [`crate::restitution`])
+//! and their uncertainties. The log arrives already read ([`crate::ingest`] reads
+//! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
+
+use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
+use crate::restitution::{coefficients, uncertainties, Coefficients};
+use crate::wall::{Rocking, Wall};
+
+/// The two channels of one log, in seconds and millimetres, outward positive.
+#[derive(Debug, Clone, Default)]
+pub struct LogData {
+    pub time_s: Vec<f64>,
+    /// Displacement at the sensor, mm, positive OUTWARD (the file's sign × outward_sign).
+    pub disp_mm: Vec<f64>,
+    /// What was read and how, e.g. "delimiter ';' (detected)".
+    pub notes: Vec<String>,
+    /// Every warning raised while reading (a dropped truncated line, …).
+    pub warnings: Vec<String>,
+}
+
+/// A reduced test.
+#[derive(Debug, Clone)]
+pub struct Reduced {
+    pub log: LogData,
+    pub analysis: Analysis,
+    pub coefficients: Coefficients,
+    /// Standard uncertainty of every value (propagated from the peaks' covariance;
+    /// default estimator only).
+    pub uncertainty: Option<Coefficients>,
+}
+
+impl Reduced {
+    /// Why the tool cannot vouch for this test's numbers, if it cannot.
+    pub fn suspect_reason(&self) -> Option<String> {
+        match &self.analysis.quality {
+            Quality::Ok => None,
+            Quality::Suspect(r) => Some(r.join("; ")),
+        }
+    }
+}
+
+/// Why a log in memory could not be reduced.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ReduceError {
+    /// The estimator found no usable peaks (no release, too few half-cycles, …).
+    #[error(transparent)]
+    Peaks(#[from] PeakError),
+    /// Eqs. 3–6 need six peaks.
+    #[error("too few peaks (n = {found} < 6)")]
+    TooFewPeaks { found: usize },
+}
+
+/// The physics the estimator starts from: the rocking kind, the sensor's lever arm
+/// about the hinge and p of the rocking part above the hinge.
+pub fn physics(rocking: Rocking, wall: &Wall, lever_arm_m: f64) -> Physics {
+    Physics {
+        rocking,
+        lever_arm_mm: lever_arm_m * 1e3,
+        p_guess: wall.rocking_part().p_squared().sqrt(),
+    }
+}
+
+/// Reduce one log: `log` holds time in s and displacement in mm, outward positive.
+pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOptions) -> Result<Reduced, ReduceError> {
+    let analysis = analyse(&log.time_s, &log.disp_mm, phys, options)?;
+    let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
+    let c = coefficients(&v, e_housner).ok_or(ReduceError::TooFewPeaks { found: v.len() })?;
+    let u = analysis.peak_covariance.as_ref().and_then(|cov| uncertainties(&v, cov, e_housner));
+    Ok(Reduced {
+        log,
+        analysis,
+        coefficients: c,
+        uncertainty: u,
+    })
+}

@@ -22,7 +22,7 @@
 //!   [`study`], ensembles in [`ensemble`], fragility curves in [`fragility`].
 //!
 //! Layout: the numeric core (every module but [`ingest`], [`report`], `cli` and
-//! [`atomic`]) touches no files and names no clap, polars, plotters or anyhow type;
+//! [`atomic`]) touches no files and names no clap, plotters or anyhow type;
 //! the domain types ([`wall::Rocking`], [`wall::Side`], [`wall::Rectangle`],
 //! [`wall::Wall`]) live there. The edges depend on it, never the reverse
 //! (`tests/architecture.rs` checks it): [`ingest`] is the only reader of files,

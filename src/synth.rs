@@ -511,6 +511,17 @@ mod tests {
     }
 }
 
+/// Why a synthetic test could not be scored.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScoreError {
+    /// The estimator gave up (its reason).
+    #[error(transparent)]
+    Peaks(#[from] crate::peaks::PeakError),
+    /// Fewer than the six peaks the table values need.
+    #[error("fewer than six peaks ({0})")]
+    FewerThanSix(usize),
+}
+
 /// The outcome of reducing one synthetic test against its truth.
 #[derive(Debug, Clone)]
 pub struct Scored {
@@ -518,7 +529,7 @@ pub struct Scored {
     pub spec: TestSpec,
     /// Worst |error| over the seven table values (percentage points), or the
     /// estimator's error message.
-    pub worst_pp: Result<f64, String>,
+    pub worst_pp: Result<f64, ScoreError>,
     /// The quality the estimator claimed ("ok", "suspect: …").
     pub status: String,
 }
@@ -543,11 +554,11 @@ pub fn score(s: &Synthetic) -> Scored {
     let tc = coefficients(&truth, e_h).expect("six true peaks");
     let res = analyse(&s.t, &s.x_mm, &phys, &PeakOptions::default());
     let (worst_pp, status) = match res {
-        Err(e) => (Err(e.to_string()), "error".to_string()),
+        Err(e) => (Err(ScoreError::Peaks(e)), "error".to_string()),
         Ok(a) => {
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
             match coefficients(&v, e_h) {
-                None => (Err("fewer than six peaks".into()), "error".into()),
+                None => (Err(ScoreError::FewerThanSix(v.len())), "error".into()),
                 Some(c) => {
                     let pairs = [
                         (c.r, tc.r),

@@ -154,8 +154,10 @@ pub enum PeakError {
     InwardStart(f64),
     #[error("too few peaks (n = {found} < {needed}): the rocking after release shows only {found} reliable half-cycles above the noise")]
     TooFewPeaks { found: usize, needed: usize },
-    #[error("the fit of the free-rocking segments failed: {0}")]
-    Fit(String),
+    #[error("the fit of the free-rocking segments failed: only {0} samples in the rocking window")]
+    FitWindow(usize),
+    #[error("the fit of the free-rocking segments failed: no starting point gave a valid model")]
+    NoValidStart,
 }
 
 /// Side of the wall a segment lies on (the one `Side` of the crate).

@@ -78,7 +78,7 @@ impl SegmentFit {
             .map(|&v| rest + lever * ((v - rest) / lever).clamp(-1.0, 1.0).asin())
             .collect();
         if tw.len() < 3 * m + 8 {
-            return Err(PeakError::Fit(format!("only {} samples in the rocking window", tw.len())));
+            return Err(PeakError::FitWindow(tw.len()));
         }
         let base = starting_model(inp, &tw, &yw, m, one_sided, t_dep, start_t, dt);
         let simple = best_simple_fit(&base, &tw, &yw, crossings, m, one_sided)?;
@@ -341,5 +341,5 @@ fn best_simple_fit(base: &Model, tw: &[f64], yw: &[f64], crossings: &[f64], m: u
             }
         }
     }
-    best.ok_or_else(|| PeakError::Fit("no starting point gave a valid model".into()))
+    best.ok_or(PeakError::NoValidStart)
 }

@@ -201,6 +201,46 @@ impl Motion {
     }
 }
 
+/// The half-cycles of a motion as it is integrated: each ends at a crossing of
+/// θ = 0 with its peak (time, sensor velocity mm/s) and its height |θ|max.
+struct HalfCycles {
+    peaks: Vec<(f64, f64)>,
+    crossings: Vec<f64>,
+    heights: Vec<f64>,
+    /// |θ|max of the half-cycle under way.
+    height: f64,
+}
+
+impl HalfCycles {
+    fn new(theta0: f64) -> HalfCycles {
+        HalfCycles {
+            peaks: Vec::new(),
+            crossings: Vec::new(),
+            heights: Vec::new(),
+            height: theta0.abs(),
+        }
+    }
+    fn grow(&mut self, theta: f64) {
+        self.height = self.height.max(theta.abs());
+    }
+    /// The half-cycle under way ends at `tc` with its `peak`.
+    fn cross(&mut self, tc: f64, peak: (f64, f64)) {
+        self.crossings.push(tc);
+        self.peaks.push(peak);
+        self.heights.push(self.height);
+        self.height = 0.0;
+    }
+    fn into_motion(self, path: Vec<(f64, f64)>, t_end: f64) -> Motion {
+        Motion {
+            path,
+            t_end,
+            peaks: self.peaks,
+            crossings: self.crossings,
+            heights: self.heights,
+        }
+    }
+}
+
 /// Eq. 1 for the rigid model on side s (the sign of θ, or of the side entered).
 fn rigid_accel(spec: &TestSpec, s: f64, th: f64) -> f64 {
     let (alpha, p2) = (spec.alpha(), spec.p2());
@@ -220,8 +260,7 @@ fn rigid_motion(spec: &TestSpec, e: &[f64]) -> Motion {
     let (mut t, mut y): (f64, State) = (0.0, [spec.theta0, 0.0]);
     let mut side = 1.0;
     let mut path = vec![(0.0, spec.theta0)];
-    let (mut peaks, mut crossings, mut heights) = (Vec::new(), Vec::new(), Vec::new());
-    let mut height: f64 = spec.theta0.abs();
+    let mut cycles = HalfCycles::new(spec.theta0);
     let mut h: f64 = 1e-4;
     let max_h = 5e-5;
     loop {
@@ -238,22 +277,19 @@ fn rigid_motion(spec: &TestSpec, e: &[f64]) -> Motion {
             let tc = find_root(|s| st.dense.at(s)[0], t, t + hh, 1e-13);
             let yc = st.dense.at(tc);
             path.push((tc, 0.0));
-            peaks.push((tc, l * yc[1]));
-            crossings.push(tc);
-            heights.push(height);
-            height = 0.0;
-            let k = crossings.len() - 1;
+            cycles.cross(tc, (tc, l * yc[1]));
+            let k = cycles.crossings.len() - 1;
             let ek = e.get(k).or(e.last()).copied().unwrap_or(1.0);
             side = -side;
             t = tc;
             y = [0.0, ek * yc[1]];
-            if crossings.len() >= MAX_IMPACTS || (ek * yc[1]).abs() < 1e-5 {
+            if cycles.crossings.len() >= MAX_IMPACTS || (ek * yc[1]).abs() < 1e-5 {
                 break;
             }
         } else {
             t += hh;
             y = st.y1;
-            height = height.max(y[0].abs());
+            cycles.grow(y[0]);
             path.push((t, y[0]));
         }
         h = next_h(hh, st.err);
@@ -262,13 +298,7 @@ fn rigid_motion(spec: &TestSpec, e: &[f64]) -> Motion {
         }
     }
     path.push((t + 1e-9, 0.0));
-    Motion {
-        path,
-        t_end: t,
-        peaks,
-        crossings,
-        heights,
-    }
+    cycles.into_motion(path, t)
 }
 
 /// Compliant contacts (module docs), fixed 20 µs steps.
@@ -291,46 +321,36 @@ fn compliant_motion(spec: &TestSpec, theta_c: f64, c_floor: f64, c_wall: f64) ->
     let hh = 2e-5;
     let (mut t, mut y): (f64, State) = (0.0, [spec.theta0, 0.0]);
     let mut path = vec![(0.0, spec.theta0)];
-    let (mut peaks, mut crossings, mut heights) = (Vec::new(), Vec::new(), Vec::new());
+    let mut cycles = HalfCycles::new(spec.theta0);
     // Half-cycle k: expected sign of its peak (k even: inward, negative).
     let mut best: (f64, f64) = (0.0, 0.0);
-    let mut height: f64 = spec.theta0.abs();
     let mut quiet = 0.0;
     while t < 30.0 {
         let k1 = f(t, &y);
         let st = step(&mut f, t, &y, &k1, hh, tol);
-        let sign = if crossings.len() % 2 == 0 { -1.0 } else { 1.0 };
+        let sign = if cycles.crossings.len() % 2 == 0 { -1.0 } else { 1.0 };
         let v = l * st.y1[0].cos() * st.y1[1];
         if sign * v > sign * best.1 {
             best = (t + hh, v);
         }
         if y[0] != 0.0 && y[0].signum() != st.y1[0].signum() && st.y1[0] != 0.0 {
             let tc = find_root(|s| st.dense.at(s)[0], t, t + hh, 1e-12);
-            crossings.push(tc);
-            peaks.push(best);
-            heights.push(height);
+            cycles.cross(tc, best);
             best = (tc, 0.0);
-            height = 0.0;
         }
         t += hh;
         y = st.y1;
-        height = height.max(y[0].abs());
+        cycles.grow(y[0]);
         if path.last().is_some_and(|p| t - p.0 >= 5e-5 - 1e-12) {
             path.push((t, y[0]));
         }
         // Stop once the motion stays below 1 µrad for 0.5 s.
         quiet = if y[0].abs() < 1e-6 && y[1].abs() < 1e-4 { quiet + hh } else { 0.0 };
-        if quiet > 0.5 || crossings.len() > 40 {
+        if quiet > 0.5 || cycles.crossings.len() > 40 {
             break;
         }
     }
-    Motion {
-        path,
-        t_end: t,
-        peaks,
-        crossings,
-        heights,
-    }
+    cycles.into_motion(path, t)
 }
 
 /// Which family a random draw comes from.

@@ -254,6 +254,33 @@ impl Model {
     /// - inward side of one-sided rocking: the damped spring arc of [`damped_arc`],
     ///   y'' = A p² − λ y − 2γ y' between its two zeros.
     pub fn arc(&self, s: usize, t: f64) -> (f64, f64) {
+        self.arc_shaped(s, self.shape(s), t)
+    }
+
+    /// A and p of arc s: the large-angle corrected pair of a gravity arc
+    /// ([`Model::gravity_arc_params`]), A and p_s of an inward spring arc (unused
+    /// for the release arc, which has its own A₀ and p₀). They depend on the
+    /// parameters only, so a sweep over the samples computes them once
+    /// ([`Model::shapes`]).
+    fn shape(&self, s: usize) -> (f64, f64) {
+        if s == 0 {
+            return (0.0, 0.0);
+        }
+        if s % 2 == 1 && self.one_sided {
+            (self.q[ix::LN_A].exp(), self.p_small())
+        } else {
+            let (ta, tb) = self.zeros(s);
+            self.gravity_arc_params(0.5 * (tb - ta))
+        }
+    }
+
+    /// [`Model::shape`] of every arc.
+    fn shapes(&self) -> Vec<(f64, f64)> {
+        (0..self.m()).map(|s| self.shape(s)).collect()
+    }
+
+    /// [`Model::arc`] with the arc's A and p given.
+    fn arc_shaped(&self, s: usize, (a, p): (f64, f64), t: f64) -> (f64, f64) {
         if s == 0 {
             let (a0, p0, tr, t0) = (self.q[ix::LN_A0].exp(), self.p(), self.release_time(), self.impact(0));
             let c = (p0 * (t0 - tr)).cosh();
@@ -265,10 +292,8 @@ impl Model {
         let tau = t - tm;
         let inward = s % 2 == 1;
         if inward && self.one_sided {
-            let (a, p) = (self.q[ix::LN_A].exp(), self.p_small());
             damped_arc(self.q[ix::LAMBDA], self.q[ix::GAMMA], a * p * p, t - ta, tb - ta)
         } else {
-            let (a, p) = self.gravity_arc_params(half);
             let sign = if inward { -1.0 } else { 1.0 };
             let den = (p * half).cosh();
             (sign * a * (1.0 - (p * tau).cosh() / den), -sign * a * p * (p * tau).sinh() / den)
@@ -327,9 +352,14 @@ impl Model {
     /// The contact phase of impact k: cubic Hermite between arc k at its onset and
     /// arc k+1 at the end of the contact.
     fn contact(&self, k: usize, t: f64) -> (f64, f64) {
+        self.contact_shaped(k, (self.shape(k), self.shape(k + 1)), t)
+    }
+
+    /// [`Model::contact`] with the two arcs' A and p given.
+    fn contact_shaped(&self, k: usize, (before, after): ((f64, f64), (f64, f64)), t: f64) -> (f64, f64) {
         let (t0, t1) = (self.onset(k), self.release_from_contact(k));
-        let (y0, v0) = self.arc(k, t0);
-        let (y1, v1) = self.arc(k + 1, t1);
+        let (y0, v0) = self.arc_shaped(k, before, t0);
+        let (y1, v1) = self.arc_shaped(k + 1, after, t1);
         let h = t1 - t0;
         let s = (t - t0) / h;
         let (s2, s3) = (s * s, s * s * s);
@@ -347,13 +377,25 @@ impl Model {
         Some((self.zero_line(t) + f, df + self.q[ix::DRIFT]))
     }
 
+    /// [`Model::eval`] at many times, the arcs' A and p computed once.
+    pub fn eval_many<'a>(&'a self, t: &'a [f64]) -> impl Iterator<Item = Option<(f64, f64)>> + 'a {
+        let shapes = self.shapes();
+        t.iter().map(move |&ti| {
+            let (f, df) = match self.owner(ti)? {
+                Piece::Arc(s) => self.arc_shaped(s, shapes[s], ti),
+                Piece::Contact(k) => self.contact_shaped(k, (shapes[k], shapes[k + 1]), ti),
+            };
+            Some((self.zero_line(ti) + f, df + self.q[ix::DRIFT]))
+        })
+    }
+
     /// Residuals y − model; false when the parameters are not a valid model.
     pub fn residuals(&self, t: &[f64], y: &[f64], out: &mut Vec<f64>) -> bool {
         out.clear();
         if !self.valid() {
             return false;
         }
-        out.extend(t.iter().zip(y).map(|(ti, yi)| self.eval(*ti).map_or(0.0, |(m, _)| yi - m)));
+        out.extend(self.eval_many(t).zip(y).map(|(m, yi)| m.map_or(0.0, |(m, _)| yi - m)));
         true
     }
 

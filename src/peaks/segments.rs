@@ -160,11 +160,10 @@ impl SegmentFit {
     /// Replace the velocity inside the fitted window by the fit's derivative.
     pub fn fill_velocity(&self, t: &[f64], v: &mut [f64]) {
         let tr = self.model().release_time();
-        for (i, &ti) in t.iter().enumerate() {
-            if ti >= tr {
-                if let Some((_, s)) = self.model().eval(ti) {
-                    v[i] = s;
-                }
+        let from = t.partition_point(|&ti| ti < tr);
+        for (vi, m) in v[from..].iter_mut().zip(self.model().eval_many(&t[from..])) {
+            if let Some((_, s)) = m {
+                *vi = s;
             }
         }
     }

@@ -74,3 +74,15 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
         uncertainty: u,
     })
 }
+
+/// Contact phases are a property of the wall, not of one test: whether most of a
+/// campaign's tests show them (a strict majority of those with status ok, at
+/// least two). Returns (tests with contact phases, tests with status ok) when
+/// they do; a test of that campaign whose own log did not ask for contact phases
+/// is then re-analysed with [`crate::peaks::ContactModel::Expected`]
+/// (`rocklab::reduce::campaign_result`).
+pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> Option<(usize, usize)> {
+    let ok: Vec<&Analysis> = analyses.into_iter().filter(|a| a.quality.is_ok()).collect();
+    let with = ok.iter().filter(|a| a.contact_phases).count();
+    (ok.len() >= 2 && 2 * with > ok.len()).then_some((with, ok.len()))
+}

@@ -11,7 +11,7 @@ use crate::campaign_means::{campaign_means, CampaignMeans, Row};
 use crate::error::InputError;
 use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::LogReader;
-use crate::peaks::{Analysis, ContactModel, Method, PeakOptions, Physics};
+use crate::peaks::{ContactModel, Method, PeakOptions, Physics};
 pub use crate::reduction::{LogData, ReduceError, Reduced};
 
 /// Why a test of a campaign has no coefficients.
@@ -179,48 +179,40 @@ pub fn campaign_result(campaign: Campaign, options: PeakOptions, tests: Vec<Test
     }
 }
 
-/// Contact phases are a property of the wall, not of one test. Where most of a
-/// campaign's tests (a strict majority of those with status ok, at least two)
-/// show finite-duration contacts, a test whose own log cannot show them (a low
-/// rate, a high noise: its instantaneous-impact fit is already at the noise
-/// level) is re-analysed with [`ContactModel::Expected`], and the new analysis
-/// is kept if it has contact phases and status ok; a warning says so. On the
-/// one-sided MuJoCo campaign this moves the 200 Hz test P1_150_1 from 1.15 pp to
-/// within 0.5 pp of the truth (three of its four tests show their contacts).
+/// Where most of the campaign's tests show finite-duration contacts
+/// ([`crate::reduction::campaign_shows_contacts`]), a test whose own log did not
+/// ask for them (a low rate, a high noise) is re-analysed with
+/// [`ContactModel::Expected`], and the new analysis is kept if it has contact
+/// phases and status ok; a warning says so. On the one-sided MuJoCo campaign this
+/// moves the 200 Hz test P1_150_1 from 1.15 pp to within 0.52 pp of the truth
+/// (three of its four tests show their contacts).
 fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests: Vec<TestOutcome>) -> Vec<TestOutcome> {
     if options.method != Method::Segments || options.contacts == ContactModel::Expected {
         return tests;
     }
-    let ok: Vec<&Analysis> = tests
-        .iter()
-        .filter_map(|t| t.result.as_ref().ok())
-        .map(|r| &r.analysis)
-        .filter(|a| a.quality.is_ok())
-        .collect();
-    let with_contacts = ok.iter().filter(|a| a.contact_phases).count();
-    if ok.len() < 2 || 2 * with_contacts <= ok.len() {
+    let analyses = tests.iter().filter_map(|t| t.result.as_ref().ok()).map(|r| &r.analysis);
+    let Some((with, n_ok)) = crate::reduction::campaign_shows_contacts(analyses) else {
         return tests;
-    }
-    let (n_ok, expected) = (
-        ok.len(),
-        PeakOptions {
-            contacts: ContactModel::Expected,
-            ..*options
-        },
-    );
+    };
+    let expected = PeakOptions {
+        contacts: ContactModel::Expected,
+        ..*options
+    };
     for t in tests.iter_mut() {
         let Ok(r) = &t.result else { continue };
         if r.analysis.contact_phases {
             continue;
         }
         let again = reduce_loaded(campaign, &t.spec, r.log.clone(), &expected);
-        if let Ok(n) = &again.result {
-            if n.analysis.contact_phases && n.analysis.quality.is_ok() {
-                t.result = again.result;
-                t.warnings.push(format!(
-                    "contact phases fitted because {with_contacts} of the campaign's {n_ok} tests show them; this log alone cannot (its instantaneous-impact fit is at the noise level)"
-                ));
-            }
+        if again
+            .result
+            .as_ref()
+            .is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok())
+        {
+            t.result = again.result;
+            t.warnings.push(format!(
+                "contact phases fitted because {with} of the campaign's {n_ok} tests with status ok show them; this log alone did not ask for them"
+            ));
         }
     }
     tests

@@ -136,6 +136,7 @@ pub fn disagreement(v: &[f64], u: &[f64], local: &[Option<(f64, f64)>]) -> Optio
 }
 
 /// Contact phases must be short beside the free arcs they join: lead and lag
+/// of impact k (`windows[k]`, or one pair per direction, `windows[k % 2]`)
 /// each below a third of the shorter adjacent gravity arc (`spring[s]`: arc s is
 /// an inward arc of one-sided rocking, itself a contact with the transverse
 /// walls, which a contact phase may cover).

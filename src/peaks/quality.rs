@@ -46,10 +46,9 @@ pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f6
         checks::misfit(&resid, sigma),
         checks::structured_near_impacts(&fit.tw, &resid, &onsets, dt, sigma),
         checks::disagreement(&v_onset, &u, local),
-        m.contact_windows().and_then(|w| {
+        m.contact_windows().and_then(|windows| {
             let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
-            let windows = if m.layout.by_direction { &w[..] } else { &w[..1] };
-            checks::contact_too_long(windows, &arcs, &spring)
+            checks::contact_too_long(&windows, &arcs, &spring)
         }),
         if fit.contacts {
             checks::contact_overshoot(&v, &v_onset, &u, &spring)

@@ -61,7 +61,7 @@
 //! (`tests/truth.rs`, README): at most 0.45 pp on the one-sided fixture campaign
 //! and 0.03 pp two-sided; 0.16 pp on the two-sided MuJoCo campaign (compliant
 //! contacts) and 1.19 pp on the one-sided one; 100.0 % of 500 random idealised
-//! tests and 88 % of 200 with compliant contacts within 1 pp, none more than
+//! tests and 87.5 % of 200 with compliant contacts within 1 pp, none more than
 //! 5 pp off with status ok (`tests/random_draw.rs`).
 //!
 //! No crate does this: it is a domain-specific piecewise model fit; the

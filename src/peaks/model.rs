@@ -421,8 +421,8 @@ impl Model {
     }
 
     /// The contact phase of impact k: quintic Hermite ([`quintic_hermite`])
-    /// between arc k at its onset and arc k+1 at the end of the contact.
-    /// The contact phase of impact k, with the arcs' shapes and the windows given.
+    /// between arc k at its onset and arc k+1 at the end of the contact (the
+    /// arcs' shapes and the windows from `frame`).
     fn contact_framed(&self, k: usize, frame: &Frame, t: f64) -> (f64, f64) {
         let ((t0, t1), before, after) = (frame.windows[k], frame.shapes[k], frame.shapes[k + 1]);
         let (y0, v0) = self.arc_shaped(k, before, t0);
@@ -477,7 +477,8 @@ impl Model {
         true
     }
 
-    /// Velocity (mm/s) at the onset of impact k (= v_k) and just after its contact.
+    /// Velocity (mm/s) of the free arcs at the onset of impact k's contact (the
+    /// end of arc k; v_k itself is [`Model::peak`]) and just after it.
     pub fn speeds(&self, k: usize) -> (f64, Option<f64>) {
         let (drift, frame) = (self.q[ix::DRIFT], self.frame());
         let (on, off) = frame.windows[k];

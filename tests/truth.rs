@@ -66,19 +66,17 @@ fn two_sided_demo_within_one_point() {
 /// energy). Truth is the extreme of the sensor velocity in each half-cycle,
 /// straight from the engine. Same 1.0 pp bound as the idealised campaigns.
 ///
-/// One-sided: 1.2 pp, the measured worst (r₁ of P1_150_2, 1.195 pp, 1.3 of its
+/// One-sided: 1.14 pp, the measured worst (r⁺ of P1_110_1, 1.135 pp, 2.2 of its
 /// stated u), so that a regression fails; the 1.0 pp is not met here.
-/// The contact model (a lead that scales as 1/speed, a C² contact phase, a
-/// restraint that cannot pull) brought the two-sided worst from 0.58 to 0.16 pp and
-/// the compliant draw from 64 % to 88 % within 1 pp; on this campaign the worst
-/// value moved from 1.001 pp (r₁⁺ of P1_90_1, now 0.14) to 1.195 pp, and the
-/// errors are now scattered at the level of the stated uncertainty (every value
-/// within 3.2 u) instead of a bias of the slow outward impacts. The 200 Hz test
-/// P1_150_1 (σ = 0.043 mm) cannot show its contacts alone and takes contact phases
-/// from its campaign (`reduce::with_campaign_contacts`).
+/// The contact model of the fourth session (a restraint that cannot pull, C²
+/// contact phases) brought the two-sided worst from 0.58 to 0.44 pp and the
+/// compliant draw from 64 % to 82 % within 1 pp; on this campaign the worst value
+/// moved from 1.001 pp (r₁⁺ of P1_90_1) to 1.135 pp. The 200 Hz test P1_150_1
+/// (σ = 0.043 mm) cannot show its contacts alone and takes contact phases from
+/// its campaign (`reduce::with_campaign_contacts`).
 #[test]
-fn mujoco_one_sided_within_1_2_points() {
-    check_within("mujoco-public-one-sided", 1.2);
+fn mujoco_one_sided_within_1_14_points() {
+    check_within("mujoco-public-one-sided", 1.14);
 }
 
 /// The campaign rule itself: P1_150_1 is fitted with contact phases and says
@@ -97,6 +95,48 @@ fn contact_phases_from_the_campaign_only_where_it_shows_them() {
         for t in load(name).tests {
             assert!(!t.result.unwrap().analysis.contact_phases, "{name}: {}", t.spec.id);
         }
+    }
+}
+
+/// The MuJoCo campaigns decimated to 100 Hz (every other sample), each log on
+/// its own: the late impacts keep a few samples each, and a contact phase has
+/// room to overshoot. A test with status ok must be within 1.1 pp, the measured
+/// worst (1.04 pp, P1_150_1, whose contacts its log alone cannot show; 200 Hz
+/// takes them from its campaign); a suspect one says why. A lead that scaled as
+/// 1/speed (tried in the fourth session) fails here: P1_150_2 2.2 pp off with
+/// status ok, and in the campaign reduction (contact phases expected) it read
+/// v₁ at 678 ± 181 mm/s, truth 427, status ok, r₁ 39 pp off. That is why the
+/// lead is one per direction.
+const BOUND_100HZ: f64 = 1.1;
+#[test]
+fn mujoco_at_100_hz_is_reduced_or_flagged() {
+    use rocklab::peaks::analyse;
+    use rocklab::reduce::{physics, read_log};
+    use rocklab::restitution::coefficients;
+    for name in ["mujoco-public-one-sided", "mujoco-public-two-sided"] {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+        let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
+        let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+        let mut ok = 0;
+        for spec in &campaign.tests {
+            let log = read_log(spec).unwrap();
+            let t: Vec<f64> = log.time_s.iter().step_by(2).copied().collect();
+            let x: Vec<f64> = log.disp_mm.iter().step_by(2).copied().collect();
+            let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", spec.id));
+            let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == spec.id.as_str()).unwrap();
+            let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
+            let c = serde_json::to_value(coefficients(&v, campaign.e_housner).unwrap()).unwrap();
+            let worst = KEYS
+                .iter()
+                .map(|k| (100.0 * (c[k].as_f64().unwrap() - tt[k].as_f64().unwrap())).abs())
+                .fold(0.0, f64::max);
+            println!("{name} {} at 100 Hz: worst {worst:.2} pp [{}]", spec.id, a.quality.describe());
+            if a.quality.is_ok() {
+                ok += 1;
+                assert!(worst <= BOUND_100HZ, "{name} {}: {worst:.2} pp off with status ok", spec.id);
+            }
+        }
+        assert!(ok >= 3, "{name}: only {ok} tests reduced at 100 Hz");
     }
 }
 

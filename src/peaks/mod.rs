@@ -40,8 +40,8 @@
 //! zero and the gravity term are all determined by the kinks of the record, and the
 //! estimator does not trust the nominal geometry (a 3–5 % error in α or p² would
 //! cost 0.5–1.9 pp, SPEC). A model with contact phases (the free arc ends a few
-//! ms before θ = 0, the earlier the slower the impact; a quintic joins it to the
-//! next with continuous acceleration: [`model`]) is fitted too and replaces it
+//! ms before θ = 0; a quintic joins it to the next with continuous
+//! acceleration: [`model`]) is fitted too and replaces it
 //! where the data ask for it (Bayesian information criterion). v_k is the
 //! extreme of the model's velocity in half-cycle k: with instantaneous impacts,
 //! the slope of the arc before impact k exactly at t_k (no smoothing bias).
@@ -59,9 +59,9 @@
 //! outward side, a sensor drift that is linear over the record, white noise, a
 //! linear (possibly lossy) inward restraint in one-sided rocking. Measured error
 //! (`tests/truth.rs`, README): at most 0.45 pp on the one-sided fixture campaign
-//! and 0.03 pp two-sided; 0.16 pp on the two-sided MuJoCo campaign (compliant
-//! contacts) and 1.19 pp on the one-sided one; 100.0 % of 500 random idealised
-//! tests and 87.5 % of 200 with compliant contacts within 1 pp, none more than
+//! and 0.03 pp two-sided; 0.44 pp on the two-sided MuJoCo campaign (compliant
+//! contacts) and 1.14 pp on the one-sided one; 100.0 % of 500 random idealised
+//! tests and 82 % of 200 with compliant contacts within 1 pp, none more than
 //! 5 pp off with status ok (`tests/random_draw.rs`).
 //!
 //! No crate does this: it is a domain-specific piecewise model fit; the

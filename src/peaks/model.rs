@@ -11,13 +11,10 @@
 //!   half-cycle slower than it entered; γ = 0 is the lossless spring of the
 //!   idealised model;
 //! - **contact phases**: impacts may take time. Arc k ends at the onset of
-//!   contact t_k − u_k, arc k+1 starts at t_k + δ + w, and in between the
+//!   contact t_k − u, arc k+1 starts at t_k + δ + w, and in between the
 //!   displacement is the quintic Hermite interpolant of the two arcs (value,
 //!   slope and curvature at both ends: a compliant contact's force starts and
 //!   ends at zero, so the wall keeps accelerating a few ms into the contact).
-//!   The lead scales as 1/speed, u_k = u |v̂₁|/|v̂_k| (v̂_k the speed of free
-//!   arc k at its zero, v̂₁ that of the first impact of the same direction): the
-//!   new edge touches at a fixed angle before θ = 0 ([`Model::window_scale`]).
 //!   u, w and δ are one set per direction. Without them (u = w = δ = 0) the
 //!   impacts are instantaneous.
 //!   The peak v_k is the extreme of the model's velocity from the end of arc k
@@ -175,7 +172,7 @@ impl Model {
         }
     }
     /// Lead and lag (s) of the contact phase of every impact, when the model has
-    /// them (the lead scaled by [`Model::window_scale`]).
+    /// them.
     pub fn contact_windows(&self) -> Option<Vec<(f64, f64)>> {
         let frame = self.frame();
         self.layout.contacts.then(|| {
@@ -211,40 +208,15 @@ impl Model {
 
     /// The arcs' shapes and the contact windows, computed once per sweep.
     fn frame(&self) -> Frame {
-        let shapes = self.shapes();
         let windows = (0..self.m())
-            .map(|k| {
-                let scale = self.window_scale(k, &shapes);
-                (self.impact(k) - self.lead(k) * scale, self.impact(k) + self.delta(k) + self.lag(k))
-            })
+            .map(|k| (self.impact(k) - self.lead(k), self.impact(k) + self.delta(k) + self.lag(k)))
             .collect();
-        Frame { shapes, windows }
-    }
-
-    /// Speed of free arc k at its zero t_k: the speed at which impact k is met.
-    fn approach_speed(&self, k: usize, shapes: &[Shape]) -> f64 {
-        self.arc_shaped(k, shapes[k], self.impact(k)).1.abs()
-    }
-
-    /// How impact k's lead scales against the first impact of its direction:
-    /// as 1/speed. The new edge touches a compliant floor at a fixed angle before
-    /// θ = 0 (the static sinking of the old edge), so the time it takes to get
-    /// there grows as the impacts slow: in the MuJoCo campaigns lead × speed
-    /// stays within 5 % while the lead grows from 3 to 17 ms. The lag does not
-    /// scale: there the contact's end moved 1.5× while the speed fell 3.9×.
-    /// (Scaling the lag too fitted the one-sided MuJoCo campaign worse: 2.2 pp.)
-    fn window_scale(&self, k: usize, shapes: &[Shape]) -> f64 {
-        if !self.layout.contacts {
-            return 1.0;
-        }
-        let first = if self.layout.by_direction { k % 2 } else { 0 };
-        let scale = self.approach_speed(first, shapes) / self.approach_speed(k, shapes);
-        if scale.is_finite() {
-            scale
-        } else {
-            1.0
+        Frame {
+            shapes: self.shapes(),
+            windows,
         }
     }
+
     /// Length of free arc s (s ≥ 1: between its zeros; the release arc from t_r).
     pub fn arc_length(&self, s: usize) -> f64 {
         if s == 0 {
@@ -525,9 +497,7 @@ impl Model {
         (best.0, best.1 + self.q[ix::DRIFT])
     }
 
-    /// The same model with contact phases: δ = 0, and u = w = `window` / s_max,
-    /// s_max the largest lead scale of the direction ([`Model::window_scale`]):
-    /// the slowest impact's lead starts at `window` s and no lead starts longer.
+    /// The same model with contact phases (δ = 0, lead = lag = `window` s).
     pub fn with_contacts(&self, window: f64) -> Model {
         let layout = Layout {
             impacts: self.m(),
@@ -535,20 +505,11 @@ impl Model {
             by_direction: self.one_sided,
         };
         let mut q = self.q[..ix::IMPACT0 + self.m()].to_vec();
-        let sets = if layout.by_direction { 2 } else { 1 };
-        q.extend(std::iter::repeat_n([0.0, 0.0, 0.0], sets).flatten());
-        let mut model = Model { layout, q, ..self.clone() };
-        let shapes = model.shapes();
-        for set in 0..sets {
-            let largest = (0..model.m())
-                .filter(|k| !layout.by_direction || k % 2 == set)
-                .map(|k| model.window_scale(k, &shapes))
-                .fold(1.0, f64::max);
-            let at = layout.delta(set);
-            model.q[at + 1] = (window / largest).ln();
-            model.q[at + 2] = (window / largest).ln();
+        q.extend_from_slice(&[0.0, window.ln(), window.ln()]);
+        if layout.by_direction {
+            q.extend_from_slice(&[0.0, window.ln(), window.ln()]);
         }
-        model
+        Model { layout, q, ..self.clone() }
     }
 
     /// Which parameters a fit frees: all but p (tied to p0), the drift (fixed by
@@ -743,20 +704,14 @@ mod tests {
         }
     }
 
-    /// The lead of each contact scales as 1/speed of the arc meeting it (lead ×
-    /// approach speed is one number per direction), the slowest impact starts
-    /// with the window asked for, and v_k is read where the wall is fastest:
-    /// past the onset, where the free arc's acceleration still acts.
+    /// v_k is read where the wall is fastest: past the onset of contact, where
+    /// the free arc's acceleration still acts (the quintic keeps it), not at the
+    /// onset; and the free arc there is slower than at its zero.
     #[test]
-    fn lead_scales_with_the_inverse_approach_speed() {
+    fn peak_past_the_onset_of_contact() {
         let (m0, m1) = (two_sided(false), two_sided(true));
-        let leads: Vec<f64> = (0..3).map(|k| m1.impact(k) - m1.onset(k)).collect();
-        let speeds: Vec<f64> = (0..3).map(|k| m0.arc(k, m0.impact(k)).1.abs()).collect();
-        for k in 1..3 {
-            assert!((leads[k] * speeds[k] / (leads[0] * speeds[0]) - 1.0).abs() < 1e-9, "{leads:?} {speeds:?}");
-        }
-        assert!((leads.iter().cloned().fold(0.0, f64::max) - 0.01).abs() < 1e-12, "{leads:?}");
         for k in 0..2 {
+            assert!((m1.impact(k) - m1.onset(k) - 0.01).abs() < 1e-12);
             let (v_onset, _) = m1.speeds(k);
             assert!((m1.arc(k, m1.onset(k)).1 - v_onset).abs() < 1e-9);
             assert!(v_onset.abs() < m0.speeds(k).0.abs(), "k {k}: a gravity arc is slower before its end");

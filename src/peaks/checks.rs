@@ -160,7 +160,8 @@ pub fn contact_too_long(windows: &[(f64, f64)], arcs: &[f64], spring: &[bool]) -
 /// but a peak more than 5 % (+ 3 u) above the free arc's speed at the onset is
 /// the interpolant's overshoot, not the wall.
 /// Only gravity arcs are checked (`spring[k]`: half-cycle k is an inward arc of
-/// one-sided rocking, whose exit is itself inside the walls' contact).
+/// one-sided rocking, whose contact phase may begin before the wall leaves the
+/// transverse walls, so that its onset speed is no reference for the peak).
 pub fn contact_overshoot(v: &[f64], v_onset: &[f64], u: &[f64], spring: &[bool]) -> Option<String> {
     v.iter().zip(v_onset).enumerate().find_map(|(k, (&vk, &vo))| {
         if spring.get(k).copied().unwrap_or(false) {

@@ -39,6 +39,14 @@ fn max_errors(name: &str) -> Vec<(String, f64)> {
     KEYS.iter().map(|k| k.to_string()).zip(worst).collect()
 }
 
+/// Error (pp) of every table value of the peaks `v` against a test's truth.
+fn errors_pp(v: &[f64], e_housner: f64, truth: &serde_json::Value) -> Vec<(&'static str, f64)> {
+    let c = serde_json::to_value(rocklab::restitution::coefficients(v, e_housner).unwrap()).unwrap();
+    KEYS.iter()
+        .map(|&k| (k, 100.0 * (c[k].as_f64().unwrap() - truth[k].as_f64().unwrap())))
+        .collect()
+}
+
 fn check(name: &str) {
     check_within(name, 1.0);
 }
@@ -112,7 +120,6 @@ const BOUND_100HZ: f64 = 1.1;
 fn mujoco_at_100_hz_is_reduced_or_flagged() {
     use rocklab::peaks::analyse;
     use rocklab::reduce::{physics, read_log};
-    use rocklab::restitution::coefficients;
     for name in ["mujoco-public-one-sided", "mujoco-public-two-sided"] {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
         let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
@@ -125,11 +132,7 @@ fn mujoco_at_100_hz_is_reduced_or_flagged() {
             let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", spec.id));
             let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == spec.id.as_str()).unwrap();
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
-            let c = serde_json::to_value(coefficients(&v, campaign.e_housner).unwrap()).unwrap();
-            let worst = KEYS
-                .iter()
-                .map(|k| (100.0 * (c[k].as_f64().unwrap() - tt[k].as_f64().unwrap())).abs())
-                .fold(0.0, f64::max);
+            let worst = errors_pp(&v, campaign.e_housner, tt).iter().map(|e| e.1.abs()).fold(0.0, f64::max);
             println!("{name} {} at 100 Hz: worst {worst:.2} pp [{}]", spec.id, a.quality.describe());
             if a.quality.is_ok() {
                 ok += 1;
@@ -154,7 +157,6 @@ fn mujoco_two_sided_within_one_point() {
 fn robust_to_decimation_spikes_clock_offset_and_drift() {
     use rocklab::peaks::analyse;
     use rocklab::reduce::{physics, read_log};
-    use rocklab::restitution::coefficients;
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/one-sided-demo");
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
@@ -184,9 +186,7 @@ fn robust_to_decimation_spikes_clock_offset_and_drift() {
         for (name, t, x) in variants {
             let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default()).unwrap_or_else(|e| panic!("{id} {name}: {e}"));
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
-            let c = serde_json::to_value(coefficients(&v, campaign.e_housner).unwrap()).unwrap();
-            for k in KEYS {
-                let err = 100.0 * (c[k].as_f64().unwrap() - tt[k].as_f64().unwrap());
+            for (k, err) in errors_pp(&v, campaign.e_housner, tt) {
                 println!("{id} {name} {k} {err:+.2}");
                 assert!(err.abs() <= 1.0, "{id} {name}: {k} off by {err:.2} pp");
             }

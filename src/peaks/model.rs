@@ -99,13 +99,6 @@ enum Shape {
     Inward(InwardArc),
 }
 
-/// The arcs' shapes and the contact windows (onset, end) of every impact, for
-/// one parameter vector ([`Model::frame`]).
-struct Frame {
-    shapes: Vec<Shape>,
-    windows: Vec<(f64, f64)>,
-}
-
 /// Which piece of the model owns a time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Piece {
@@ -174,16 +167,7 @@ impl Model {
     /// Lead and lag (s) of the contact phase of every impact, when the model has
     /// them.
     pub fn contact_windows(&self) -> Option<Vec<(f64, f64)>> {
-        let frame = self.frame();
-        self.layout.contacts.then(|| {
-            let zero = |k: usize| self.impact(k) + self.delta(k);
-            frame
-                .windows
-                .iter()
-                .enumerate()
-                .map(|(k, &(on, off))| (self.impact(k) - on, off - zero(k)))
-                .collect()
-        })
+        self.layout.contacts.then(|| (0..self.m()).map(|k| (self.lead(k), self.lag(k))).collect())
     }
     pub fn release_time(&self) -> f64 {
         self.q[ix::T_R]
@@ -199,22 +183,11 @@ impl Model {
     }
     /// Onset of contact of impact k (the end of free arc k).
     pub fn onset(&self, k: usize) -> f64 {
-        self.frame().windows[k].0
+        self.impact(k) - self.lead(k)
     }
     /// End of the contact of impact k (the start of free arc k+1).
     pub fn release_from_contact(&self, k: usize) -> f64 {
-        self.frame().windows[k].1
-    }
-
-    /// The arcs' shapes and the contact windows, computed once per sweep.
-    fn frame(&self) -> Frame {
-        let windows = (0..self.m())
-            .map(|k| (self.impact(k) - self.lead(k), self.impact(k) + self.delta(k) + self.lag(k)))
-            .collect();
-        Frame {
-            shapes: self.shapes(),
-            windows,
-        }
+        self.impact(k) + self.delta(k) + self.lag(k)
     }
 
     /// Length of free arc s (s ≥ 1: between its zeros; the release arc from t_r).
@@ -239,10 +212,9 @@ impl Model {
         if !self.q.iter().all(|v| v.is_finite()) {
             return false;
         }
-        let frame = self.frame();
         let mut prev = self.release_time();
         for k in 0..self.m() {
-            let (on, off) = frame.windows[k];
+            let on = self.onset(k);
             if on - prev < self.min_len {
                 return false;
             }
@@ -252,7 +224,7 @@ impl Model {
                     return false;
                 }
             }
-            prev = if k + 1 < self.m() { off } else { on };
+            prev = if k + 1 < self.m() { self.release_from_contact(k) } else { on };
             if prev < on {
                 return false;
             }
@@ -273,13 +245,13 @@ impl Model {
     }
 
     /// The piece owning t; None past the last impact's onset.
-    fn owner(&self, windows: &[(f64, f64)], t: f64) -> Option<Piece> {
+    fn owner(&self, t: f64) -> Option<Piece> {
         let m = self.m();
-        for (k, &(on, off)) in windows.iter().enumerate() {
-            if t < on {
+        for k in 0..m {
+            if t < self.onset(k) {
                 return Some(Piece::Arc(k));
             }
-            if k + 1 < m && t < off {
+            if k + 1 < m && t < self.release_from_contact(k) {
                 return Some(Piece::Contact(k));
             }
         }
@@ -394,9 +366,9 @@ impl Model {
 
     /// The contact phase of impact k: quintic Hermite ([`quintic_hermite`])
     /// between arc k at its onset and arc k+1 at the end of the contact (the
-    /// arcs' shapes and the windows from `frame`).
-    fn contact_framed(&self, k: usize, frame: &Frame, t: f64) -> (f64, f64) {
-        let ((t0, t1), before, after) = (frame.windows[k], frame.shapes[k], frame.shapes[k + 1]);
+    /// arcs' shapes given, [`Model::shapes`]).
+    fn contact_shaped(&self, k: usize, shapes: &[Shape], t: f64) -> (f64, f64) {
+        let (t0, t1, before, after) = (self.onset(k), self.release_from_contact(k), shapes[k], shapes[k + 1]);
         let (y0, v0) = self.arc_shaped(k, before, t0);
         let (y1, v1) = self.arc_shaped(k + 1, after, t1);
         let (a0, a1) = (self.arc_accel(k, before, t0, (y0, v0)), self.arc_accel(k + 1, after, t1, (y1, v1)));
@@ -429,11 +401,11 @@ impl Model {
 
     /// [`Model::eval`] at many times, the arcs' A and p computed once.
     pub fn eval_many<'a>(&'a self, t: &'a [f64]) -> impl Iterator<Item = Option<(f64, f64)>> + 'a {
-        let frame = self.frame();
+        let shapes = self.shapes();
         t.iter().map(move |&ti| {
-            let (f, df) = match self.owner(&frame.windows, ti)? {
-                Piece::Arc(s) => self.arc_shaped(s, frame.shapes[s], ti),
-                Piece::Contact(k) => self.contact_framed(k, &frame, ti),
+            let (f, df) = match self.owner(ti)? {
+                Piece::Arc(s) => self.arc_shaped(s, shapes[s], ti),
+                Piece::Contact(k) => self.contact_shaped(k, &shapes, ti),
             };
             Some((self.zero_line(ti) + f, df + self.q[ix::DRIFT]))
         })
@@ -452,10 +424,9 @@ impl Model {
     /// Velocity (mm/s) of the free arcs at the onset of impact k's contact (the
     /// end of arc k; v_k itself is [`Model::peak`]) and just after it.
     pub fn speeds(&self, k: usize) -> (f64, Option<f64>) {
-        let (drift, frame) = (self.q[ix::DRIFT], self.frame());
-        let (on, off) = frame.windows[k];
-        let before = self.arc_shaped(k, frame.shapes[k], on).1 + drift;
-        let after = (k + 1 < self.m()).then(|| self.arc_shaped(k + 1, frame.shapes[k + 1], off).1 + drift);
+        let drift = self.q[ix::DRIFT];
+        let before = self.arc(k, self.onset(k)).1 + drift;
+        let after = (k + 1 < self.m()).then(|| self.arc(k + 1, self.release_from_contact(k)).1 + drift);
         (before, after)
     }
 
@@ -467,12 +438,12 @@ impl Model {
     /// inside it, before the crossing; on a lossy inward arc it may come before
     /// the arc's end. Returns (time, velocity mm/s).
     pub fn peak(&self, k: usize) -> (f64, f64) {
-        let frame = self.frame();
-        let v_end_t = frame.windows[k].0;
-        let v_end = self.arc_shaped(k, frame.shapes[k], v_end_t).1;
-        let start = if k == 0 { self.release_time() } else { frame.windows[k - 1].1 };
+        let shapes = self.shapes();
+        let v_end_t = self.onset(k);
+        let v_end = self.arc_shaped(k, shapes[k], v_end_t).1;
+        let start = if k == 0 { self.release_time() } else { self.release_from_contact(k - 1) };
         let from = v_end_t - 0.25 * (v_end_t - start);
-        let to = if k + 1 < self.m() { frame.windows[k].1 } else { v_end_t };
+        let to = if k + 1 < self.m() { self.release_from_contact(k) } else { v_end_t };
         let want = if k % 2 == 0 { -1.0 } else { 1.0 };
         // Half-cycle k lies on the outward side for k even.
         let side = -want;
@@ -483,9 +454,9 @@ impl Model {
             // Arc k up to its end, then the contact phase (never arc k+1: its
             // start speed is the speed after the impact).
             let (y, v) = if t > v_end_t && k + 1 < self.m() {
-                self.contact_framed(k, &frame, t)
+                self.contact_shaped(k, &shapes, t)
             } else {
-                self.arc_shaped(k, frame.shapes[k], t)
+                self.arc_shaped(k, shapes[k], t)
             };
             if side * y < 0.0 {
                 break;

@@ -6,7 +6,7 @@
 //!   y'' = F + p² y + R,  R = max(0, −κ y − 2γ y'),  F = A p²,
 //!
 //! gravity (F + p² y, Eq. 1 linearised about θ = 0) and the restraint's push R.
-//! While the restraint bears (R > 0) this is the linear arc of [`damped_arc`],
+//! While the restraint bears (R > 0) this is the linear arc of [`InwardArc::linear`],
 //! y'' = F − λ y − 2γ y' with λ = κ − p². On the way in (y' < 0) and at the apex
 //! R > 0. On the way out the dashpot pulls against the spring, and where
 //! κ |y| = 2γ y' the restraint would have to pull: a contact cannot, so the wall
@@ -24,7 +24,7 @@
 //! cost thousands and be neither smooth in the parameters (which the
 //! Levenberg–Marquardt Jacobian needs) nor exact.
 
-/// φ₂, φ₂' and ψ of the linear arc at τ (see [`damped_arc`]), with ψ by its
+/// φ₂, φ₂' and ψ of the linear arc at τ (see [`InwardArc::linear`]), with ψ by its
 /// series where |λ| T² is small (T = `t_len`).
 fn parts(lambda: f64, gamma: f64, t_len: f64, x: f64) -> (f64, f64, f64) {
     let mu2 = gamma * gamma - lambda;
@@ -48,24 +48,7 @@ fn parts(lambda: f64, gamma: f64, t_len: f64, x: f64) -> (f64, f64, f64) {
     (psi, phi2, dphi2)
 }
 
-/// The inward arc of one-sided rocking with a lossy restraint that may pull: the
-/// solution of y'' = F − λ y − 2γ y' with y(0) = y(T) = 0, at τ ∈ [0, T]
-/// (y = L θ, F = A p², λ = κ − p²), and its slope:
-///
-///   y = F ψ(τ) + v₀ φ₂(τ),  v₀ = −F ψ(T) / φ₂(T),
-///
-/// with φ₂ = e^{−γτ} S(τ) (φ₂(0) = 0, φ₂'(0) = 1), φ₁ = e^{−γτ} (C + γ S),
-/// ψ = (1 − φ₁)/λ the unit step response (ψ' = φ₂), C = cosh μτ and S = sinh(μτ)/μ
-/// for μ² = γ² − λ (cos and sin/ω when μ² < 0). Near λ = 0, ψ comes from its power
-/// series, (n+2)(n+1) a_{n+2} = [n = 0] − 2γ (n+1) a_{n+1} − λ a_n.
-pub fn damped_arc(lambda: f64, gamma: f64, f: f64, tau: f64, t_len: f64) -> (f64, f64) {
-    let (psi_t, phi2_t, _) = parts(lambda, gamma, t_len, t_len);
-    let v0 = -f * psi_t / phi2_t;
-    let (psi, phi2, dphi2) = parts(lambda, gamma, t_len, tau);
-    (f * psi + v0 * phi2, f * phi2 + v0 * dphi2)
-}
-
-/// ψ(τ) of [`damped_arc`] by its power series (|λ| τ² small).
+/// ψ(τ) of [`InwardArc::linear`] by its power series (|λ| τ² small).
 fn step_response_series(lambda: f64, gamma: f64, x: f64) -> f64 {
     let (mut a1, mut a2) = (0.0, 0.5);
     let mut sum = 0.5 * x * x;
@@ -159,20 +142,33 @@ fn free_zero(f: f64, p: f64, ys: f64, vs: f64) -> Option<f64> {
 }
 
 impl InwardArc {
-    /// The arc of length `t_len` for λ, γ, F = A p² and p.
-    pub fn solve(lambda: f64, gamma: f64, f: f64, p: f64, t_len: f64) -> InwardArc {
-        let linear = InwardArc {
+    /// The linear arc (a restraint that may pull, γ ≤ 0 or no separation): the
+    /// solution of y'' = F − λ y − 2γ y' with y(0) = y(T) = 0 on τ ∈ [0, T]
+    /// (y = L θ, F = A p², λ = κ − p²; [`InwardArc::at`] gives y and y'):
+    ///
+    ///   y = F ψ(τ) + v₀ φ₂(τ),  v₀ = −F ψ(T) / φ₂(T),
+    ///
+    /// with φ₂ = e^{−γτ} S(τ) (φ₂(0) = 0, φ₂'(0) = 1), φ₁ = e^{−γτ} (C + γ S),
+    /// ψ = (1 − φ₁)/λ the unit step response (ψ' = φ₂), C = cosh μτ and S = sinh(μτ)/μ
+    /// for μ² = γ² − λ (cos and sin/ω when μ² < 0). Near λ = 0, ψ comes from its power
+    /// series, (n+2)(n+1) a_{n+2} = [n = 0] − 2γ (n+1) a_{n+1} − λ a_n.
+    pub fn linear(lambda: f64, gamma: f64, f: f64, p: f64, t_len: f64) -> InwardArc {
+        let (psi_t, phi2_t, _) = parts(lambda, gamma, t_len, t_len);
+        InwardArc {
             lambda,
             gamma,
             f,
             p,
             t_len,
-            v0: {
-                let (psi_t, phi2_t, _) = parts(lambda, gamma, t_len, t_len);
-                -f * psi_t / phi2_t
-            },
+            v0: -f * psi_t / phi2_t,
             sep: None,
-        };
+        }
+    }
+
+    /// The arc of length `t_len` for λ, γ, F = A p² and p: [`InwardArc::linear`]
+    /// up to the separation, if the restraint lets go before y = 0.
+    pub fn solve(lambda: f64, gamma: f64, f: f64, p: f64, t_len: f64) -> InwardArc {
+        let linear = Self::linear(lambda, gamma, f, p, t_len);
         if gamma <= 0.0 || f.is_nan() || f <= 0.0 {
             return linear;
         }
@@ -257,6 +253,11 @@ impl InwardArc {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// y and y' of the linear arc (p plays no part in it).
+    fn damped_arc(lambda: f64, gamma: f64, f: f64, tau: f64, t_len: f64) -> (f64, f64) {
+        InwardArc::linear(lambda, gamma, f, 2.2, t_len).at(tau)
+    }
 
     /// The lossless inward arc (the estimator's before issue #9, the reference for
     /// γ = 0): the inward arc of one-sided rocking between two impacts, per unit A p²:

@@ -44,7 +44,10 @@
 //! acceleration: [`model`]) is fitted too and replaces it
 //! where the data ask for it (Bayesian information criterion). v_k is the
 //! extreme of the model's velocity in half-cycle k: with instantaneous impacts,
-//! the slope of the arc before impact k exactly at t_k (no smoothing bias).
+//! the slope of the arc before impact k exactly at t_k (no smoothing bias); with
+//! contact phases, whose smooth joins leave the fitted zero loose by a few mm,
+//! the mean of the readings up to the fitted zero and up to the rest line, their
+//! spread a term of its uncertainty ([`model::Model::peak`]).
 //!
 //! Before the fit: isolated spikes are replaced, the line through the final rest
 //! (its slope shared with the initial hold) is subtracted (the sensor's zero and a
@@ -60,7 +63,7 @@
 //! linear (possibly lossy) inward restraint in one-sided rocking. Measured error
 //! (`tests/truth.rs`, README): at most 0.45 pp on the one-sided fixture campaign
 //! and 0.03 pp two-sided; 0.44 pp on the two-sided MuJoCo campaign (compliant
-//! contacts) and 1.14 pp on the one-sided one; 100.0 % of 500 random idealised
+//! contacts) and 0.75 pp on the one-sided one; 100.0 % of 500 random idealised
 //! tests and 82 % of 200 with compliant contacts within 1 pp, none more than
 //! 5 pp off with status ok (`tests/random_draw.rs`).
 //!
@@ -366,6 +369,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         if let Some(alt) = &fit.alternative {
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
+        uncertainty::add_zero_spread(&mut c, fit.model());
         c
     });
     let peaks: Vec<Peak> = impacts

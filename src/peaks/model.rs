@@ -18,8 +18,9 @@
 //!   u, w and δ are one set per direction. Without them (u = w = δ = 0) the
 //!   impacts are instantaneous.
 //!   The peak v_k is the extreme of the model's velocity from the end of arc k
-//!   through its contact phase (SPEC: the extreme of the velocity in the
-//!   half-cycle; [`Model::peak`]).
+//!   through its contact phase up to θ = 0 (SPEC: the extreme of the velocity
+//!   in the half-cycle); θ = 0 is located twice, by the fitted zero and by the
+//!   rest line, and v_k is the mean of the two readings ([`Model::peak`]).
 //!
 //! Parameters live in one vector; [`Layout`] names every position.
 
@@ -432,13 +433,46 @@ impl Model {
 
     /// The velocity peak v_k of half-cycle k (SPEC): the extreme of the model's
     /// velocity, with the sign of the motion towards impact k, from the last
-    /// quarter of free arc k through the contact phase up to the model's zero
-    /// crossing. With instantaneous impacts this is the arc's slope at t_k (a
-    /// gravity arc is fastest at its end); with a contact phase the peak may fall
-    /// inside it, before the crossing; on a lossy inward arc it may come before
-    /// the arc's end. Returns (time, velocity mm/s).
+    /// quarter of free arc k through the contact phase up to the end of the
+    /// half-cycle, θ = 0. With instantaneous impacts this is the arc's slope at
+    /// t_k (a gravity arc is fastest at its end); with a contact phase the peak
+    /// may fall inside it, before the crossing; on a lossy inward arc it may
+    /// come before the arc's end. Returns (time, velocity mm/s).
+    ///
+    /// Where θ = 0 lies has two estimates: the model's own zero (z, where its
+    /// arcs are pinned) and the rest line (the sensor's zero after the final
+    /// rest is subtracted, `prepare.rs`). With instantaneous impacts the kinks
+    /// fix z to the noise and both readings end at the arc's zero; with contact
+    /// phases the kinks are smoothed out and z may move by a few mm (one-sided
+    /// MuJoCo logs: 1.1–1.9 mm inside the inward side, while the rest line is
+    /// within 0.12 mm of the engine's θ = 0; README, accuracy), and a peak
+    /// inside the contact phase depends on which zero ends the half-cycle. The truth is taken as anywhere between the two readings
+    /// (rectangular): v_k is their mean, and [`Model::peak_spread`] their
+    /// difference, a model-form term of its uncertainty (`uncertainty.rs`).
     pub fn peak(&self, k: usize) -> (f64, f64) {
         let shapes = self.shapes();
+        let a = self.reading(k, &shapes, false);
+        if !self.layout.contacts {
+            // Without contact phases both readings end at the arc's zero.
+            return a;
+        }
+        let b = self.reading(k, &shapes, true);
+        (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1))
+    }
+
+    /// The rest-line reading of v_k minus the model-zero reading (mm/s; see
+    /// [`Model::peak`]).
+    pub fn peak_spread(&self, k: usize) -> f64 {
+        if !self.layout.contacts {
+            return 0.0;
+        }
+        let shapes = self.shapes();
+        self.reading(k, &shapes, true).1 - self.reading(k, &shapes, false).1
+    }
+
+    /// One reading of v_k: the extreme up to the model's zero, or, with
+    /// `rest_line`, up to the later of the model's zero and the rest line.
+    fn reading(&self, k: usize, shapes: &[Shape], rest_line: bool) -> (f64, f64) {
         let v_end_t = self.onset(k);
         let v_end = self.arc_shaped(k, shapes[k], v_end_t).1;
         let start = if k == 0 { self.release_time() } else { self.release_from_contact(k - 1) };
@@ -454,11 +488,12 @@ impl Model {
             // Arc k up to its end, then the contact phase (never arc k+1: its
             // start speed is the speed after the impact).
             let (y, v) = if t > v_end_t && k + 1 < self.m() {
-                self.contact_shaped(k, &shapes, t)
+                self.contact_shaped(k, shapes, t)
             } else {
                 self.arc_shaped(k, shapes[k], t)
             };
-            if side * y < 0.0 {
+            let past_rest_line = !rest_line || side * (y + self.zero_line(t)) < 0.0;
+            if side * y < 0.0 && past_rest_line {
                 break;
             }
             if want * v > want * best.1 {
@@ -692,6 +727,45 @@ mod tests {
                 "k {k}: peak {t_peak} {v_peak}, onset {v_onset}"
             );
         }
+    }
+
+    /// Where the model's zero and the rest line differ, v_k is the mean of the
+    /// readings up to each, and the spread is their difference: zero where
+    /// they agree, and zero without contact phases (both readings end at the
+    /// arc's zero).
+    #[test]
+    fn peak_between_the_model_zero_and_the_rest_line() {
+        let mut m = two_sided(true);
+        // A contact that starts 1 ms before the zero and lasts 30 ms after it,
+        // into an arc longer (faster at its start) than the one before: the
+        // velocity still rises past the model's zero.
+        m.q[m.layout.lead(0)] = 0.001f64.ln();
+        m.q[m.layout.lag(0)] = 0.03f64.ln();
+        m.q[ix::IMPACT0 + 2] = 3.2;
+        assert!(m.valid());
+        assert!((0..3).all(|k| m.peak_spread(k) == 0.0), "the zero on the rest line");
+        // The model's zero 3 mm below the rest line: the half-cycles on the
+        // inward side (k odd) end later at the rest line than at the model's zero.
+        m.q[ix::ZERO] = -3.0;
+        let shapes = m.shapes();
+        let mut spread = 0.0;
+        for k in 0..2 {
+            let want = if k % 2 == 0 { -1.0 } else { 1.0 };
+            let (a, b) = (m.reading(k, &shapes, false), m.reading(k, &shapes, true));
+            let (t, v) = m.peak(k);
+            assert!((v - 0.5 * (a.1 + b.1)).abs() < 1e-12 && (t - 0.5 * (a.0 + b.0)).abs() < 1e-12);
+            assert!((m.peak_spread(k) - (b.1 - a.1)).abs() < 1e-12);
+            // The rest-line reading searches a longer stretch: never slower.
+            assert!(want * (b.1 - a.1) >= 0.0, "k {k}: {a:?} {b:?}");
+            if k % 2 == 0 {
+                assert_eq!(a, b, "k {k}: the model's zero comes later");
+            }
+            spread += (b.1 - a.1).abs();
+        }
+        assert!(spread > 1.0, "the inward half-cycle's reading moved by {spread} mm/s");
+        let mut plain = two_sided(false);
+        plain.q[ix::ZERO] = -3.0;
+        assert!((0..3).all(|k| plain.peak_spread(k) == 0.0), "no contact phases");
     }
 
     /// Two impacts may not collapse onto one instant.

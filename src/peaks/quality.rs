@@ -55,6 +55,7 @@ pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f6
         } else {
             None
         },
+        checks::zero_readings_disagree(&v, &(0..v.len()).map(|k| m.peak_spread(k)).collect::<Vec<_>>()),
     ]
     .into_iter()
     .flatten()

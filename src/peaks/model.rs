@@ -446,8 +446,9 @@ impl Model {
     /// phases the kinks are smoothed out and z may move by a few mm (one-sided
     /// MuJoCo logs: 1.1–1.9 mm inside the inward side, while the rest line is
     /// within 0.12 mm of the engine's θ = 0; README, accuracy), and a peak
-    /// inside the contact phase depends on which zero ends the half-cycle. The truth is taken as anywhere between the two readings
-    /// (rectangular): v_k is their mean, and [`Model::peak_spread`] their
+    /// inside the contact phase depends on which zero ends the half-cycle. The
+    /// truth is taken as anywhere between the two readings (rectangular): v_k
+    /// (and its time) is their mean, and [`Model::peak_spread`] their
     /// difference, a model-form term of its uncertainty (`uncertainty.rs`).
     pub fn peak(&self, k: usize) -> (f64, f64) {
         let shapes = self.shapes();

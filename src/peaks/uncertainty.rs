@@ -39,11 +39,7 @@ pub(super) fn add_model_spread(cov: &mut [Vec<f64>], impacts: &[Impact], alterna
             _ => 0.0,
         })
         .collect();
-    for (a, row) in cov.iter_mut().enumerate() {
-        for (b, c) in row.iter_mut().enumerate() {
-            *c += d[a] * d[b] / 3.0;
-        }
-    }
+    add_correlated(cov, &d, 1.0 / 3.0);
 }
 
 /// The model-form part of the uncertainty from where θ = 0 lies
@@ -55,9 +51,14 @@ pub(super) fn add_model_spread(cov: &mut [Vec<f64>], impacts: &[Impact], alterna
 /// without contact phases.
 pub(super) fn add_zero_spread(cov: &mut [Vec<f64>], m: &model::Model) {
     let d: Vec<f64> = (0..cov.len()).map(|k| m.peak_spread(k)).collect();
+    add_correlated(cov, &d, 1.0 / 12.0);
+}
+
+/// Σ += w d dᵀ: a term whose parts share one cause (fully correlated).
+fn add_correlated(cov: &mut [Vec<f64>], d: &[f64], w: f64) {
     for (a, row) in cov.iter_mut().enumerate() {
         for (b, c) in row.iter_mut().enumerate() {
-            *c += d[a] * d[b] / 12.0;
+            *c += w * d[a] * d[b];
         }
     }
 }

@@ -74,7 +74,7 @@ fn two_sided_demo_within_one_point() {
 /// One-sided: the worst value is 0.75 pp (r₁ of P1_90_1). Until the fifth
 /// session it was 1.135 pp (r⁺ of P1_110_1): the fitted zero of a contact fit
 /// sat 1.9 mm inside the inward side, and the last outward peak, read up to that
-/// zero, ended 11 ms before the true crossing, 6 % low. v_k is now the mean of
+/// zero, ended 12 ms before the true crossing, 6 % low. v_k is now the mean of
 /// the readings up to the fitted zero and up to the rest line
 /// ([`rocklab::peaks::model::Model::peak`]), with their spread in its
 /// uncertainty. The 200 Hz test P1_150_1 (σ = 0.043 mm) cannot show its

@@ -362,6 +362,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);
     let impacts = fit.impacts();
+    // Each peak's two readings of where its half-cycle ends (zero without
+    // contact phases): a term of its uncertainty and a check.
+    let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
     let cov = fit.fitted.peak_covariance(n_peaks).map(|mut c| {
         if !fit.contacts {
             uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
@@ -369,7 +372,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         if let Some(alt) = &fit.alternative {
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
-        uncertainty::add_zero_spread(&mut c, fit.model());
+        uncertainty::add_zero_spread(&mut c, &spread);
         c
     });
     let peaks: Vec<Peak> = impacts
@@ -383,7 +386,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         })
         .collect();
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-    let verdict = quality::plausibility(&fit, &peaks, &local, p.dt, p.sigma);
+    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, p.dt, p.sigma);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,

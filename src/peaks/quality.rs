@@ -24,8 +24,10 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
         .collect()
 }
 
-/// Run every check of [`checks`] on a fit.
-pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f64, f64)>], dt: f64, sigma: f64) -> Quality {
+/// Run every check of [`checks`] on a fit (`spread[k]`: the difference between
+/// peak k's two readings of where its half-cycle ends,
+/// [`super::model::Model::peak_spread`]).
+pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f64, f64)>], spread: &[f64], dt: f64, sigma: f64) -> Quality {
     let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
     let u: Vec<f64> = peaks.iter().map(|p| p.velocity_u_mm_s.unwrap_or(0.0)).collect();
     let m = fit.model();
@@ -55,7 +57,7 @@ pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f6
         } else {
             None
         },
-        checks::zero_readings_disagree(&v, &(0..v.len()).map(|k| m.peak_spread(k)).collect::<Vec<_>>()),
+        checks::zero_readings_disagree(&v, spread),
     ]
     .into_iter()
     .flatten()

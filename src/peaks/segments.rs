@@ -7,7 +7,8 @@
 //! inward λ in one-sided rocking, where one start can land in a wrong minimum).
 //! Isolated spikes the spike filter missed are then left out ([`reject_outliers`]).
 //! Where it misses the samples around its impacts (RMS > 1.2 σ), the model with
-//! contact phases (three more parameters per direction) is then fitted from it, twice: windows of two samples and of 10 ms. It replaces the
+//! contact phases (three more parameters per direction) is then fitted from it,
+//! twice: windows of two samples and of 10 ms. It replaces the
 //! first only when the data ask for it clearly: the Bayesian information
 //! criterion, (cost₁ − cost₂)/σ² > k ln n (σ the measured noise, k the extra
 //! parameters, n the samples). On logs made with instantaneous impacts the

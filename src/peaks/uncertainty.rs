@@ -45,13 +45,12 @@ pub(super) fn add_model_spread(cov: &mut [Vec<f64>], impacts: &[Impact], alterna
 /// The model-form part of the uncertainty from where θ = 0 lies
 /// ([`model::Model::peak`]): v_k is the mean of two readings, up to the model's
 /// zero and up to the rest line, and the truth is taken as anywhere between
-/// them (rectangular, full width |d_k|, d_k = [`model::Model::peak_spread`]):
-/// u² = d_k²/12 (GUM 4.3.7). The d_k of one test share their cause (the
-/// fitted zero), so the term is added fully correlated, Σ += d dᵀ/12. Zero
-/// without contact phases.
-pub(super) fn add_zero_spread(cov: &mut [Vec<f64>], m: &model::Model) {
-    let d: Vec<f64> = (0..cov.len()).map(|k| m.peak_spread(k)).collect();
-    add_correlated(cov, &d, 1.0 / 12.0);
+/// them (rectangular, full width |d_k|, `spread[k]` =
+/// [`model::Model::peak_spread`]): u² = d_k²/12 (GUM 4.3.7). The d_k of one
+/// test share their cause (the fitted zero), so the term is added fully
+/// correlated, Σ += d dᵀ/12. Zero without contact phases.
+pub(super) fn add_zero_spread(cov: &mut [Vec<f64>], spread: &[f64]) {
+    add_correlated(cov, spread, 1.0 / 12.0);
 }
 
 /// Σ += w d dᵀ: a term whose parts share one cause (fully correlated).

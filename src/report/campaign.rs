@@ -39,6 +39,7 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
     if let Some(map) = doc.as_object_mut() {
         map.extend(extra.summary.clone());
     }
+    super::docs::gather_timing(&mut doc);
     files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
     let tabs = tables::tables(res);
     table_files(res, &tabs, &mut files)?;

@@ -655,3 +655,141 @@ fn facade_ensemble_errors() {
     let o = facade(&study, &dir.path().join("o"), &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("sd_e = -0.1"));
 }
+
+/// Issue #21: `rocklab init` on a copy of the demo's logs, then the wall filled in
+/// as the demo's manifest has it, gives the demo's numbers; before that, `reduce`
+/// refuses the manifest naming the key; an existing manifest is kept unless
+/// `--force`.
+#[test]
+fn init_then_fill_in_then_reduce_gives_the_demos_numbers() {
+    let dir = tempfile::tempdir().unwrap();
+    let logs = dir.path().join("wall");
+    std::fs::create_dir(&logs).unwrap();
+    for t in ["150_1", "150_2", "150_3", "100_1", "50_1"] {
+        std::fs::copy(fixtures().join(format!("one-sided-demo/{t}.csv")), logs.join(format!("{t}.csv"))).unwrap();
+    }
+    std::fs::write(logs.join("notes.xlsx"), b"PK").unwrap();
+    let rocklab = || Command::new(env!("CARGO_BIN_EXE_rocklab"));
+    let o = rocklab().arg("init").arg(&logs).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let manifest = logs.join("campaign.toml");
+    let draft = std::fs::read_to_string(&manifest).unwrap();
+    assert_eq!(draft.matches("\n[[test]]\n").count(), 5, "{draft}");
+    assert!(draft.contains("#   notes.xlsx: a .xlsx log"), "{draft}");
+    assert!(draft.contains("time = { column = \"time_s\", unit = \"s\" }"), "{draft}");
+    assert!(draft.contains("200 Hz"), "{draft}");
+
+    // Unfilled: refused, naming the key and its line.
+    let out = dir.path().join("out");
+    let r = reduce(&manifest, &out, &[]);
+    assert_ne!(r.code, 0);
+    assert!(
+        r.stderr.contains("campaign.toml:8:1: [campaign].rocking is not filled in yet"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out.join("summary.json").exists(), "nothing written from an unfilled manifest");
+
+    // An existing manifest is kept without --force, replaced with it.
+    std::fs::write(&manifest, "# mine\n").unwrap();
+    let o = rocklab().arg("init").arg(&logs).output().unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--force"));
+    assert_eq!(std::fs::read_to_string(&manifest).unwrap(), "# mine\n");
+    let o = rocklab().arg("init").arg(&logs).arg("--force").output().unwrap();
+    assert!(o.status.success());
+    assert_eq!(std::fs::read_to_string(&manifest).unwrap(), draft);
+
+    // Filled in as the demo's manifest says (and 50_1 left out of the means as there).
+    let fill = |text: &str, key: &str, value: &str| -> String {
+        let i = text.find(&format!("{key} = \"fill in")).unwrap_or_else(|| panic!("{key} in {text}"));
+        let end = i + text[i..].find("\"").unwrap() + 1;
+        let end = end + text[end..].find('"').unwrap() + 1;
+        format!("{}{key} = {value}{}", &text[..i], &text[end..])
+    };
+    let mut text = draft.replace(&format!("name = {:?}", "wall"), "name = \"one-sided-demo\"");
+    for (k, v) in [
+        ("rocking", "\"one-sided\""),
+        ("height_m", "2.70"),
+        ("thickness_m", "0.36"),
+        ("hinge_height_m", "0.23"),
+        ("height_m", "2.56"),
+    ] {
+        text = fill(&text, k, v);
+    }
+    text = text.replace(
+        "id = \"50_1\"\nfile = \"50_1.csv\"\nexclude_from_mean = false",
+        "id = \"50_1\"\nfile = \"50_1.csv\"\nexclude_from_mean = true",
+    );
+    std::fs::write(&manifest, &text).unwrap();
+    let r = reduce(&manifest, &out, &[]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let demo_out = dir.path().join("demo");
+    let d = reduce(&fixtures().join("one-sided-demo/campaign.toml"), &demo_out, &[]);
+    assert_eq!(d.code, 0, "{}", d.stderr);
+    // The same tests in another order (init sorts the files by name): every value
+    // equal, the means to 1e-12 (their sums run in the tests' order).
+    let by_id = |mut s: Value| {
+        s["tests"].as_array_mut().unwrap().sort_by_key(|t| t["id"].as_str().unwrap().to_string());
+        s["mean_included"]
+            .as_array_mut()
+            .unwrap()
+            .sort_by_key(|t| t.as_str().unwrap().to_string());
+        s
+    };
+    let mut diffs = Vec::new();
+    same_numbers(&by_id(r.summary.clone()), &by_id(d.summary.clone()), "", &mut diffs);
+    assert!(diffs.is_empty(), "init + fill in ≠ the demo's manifest:\n{}", diffs.join("\n"));
+    assert_eq!(r.summary["tests"].as_array().unwrap().len(), 5);
+    assert_eq!(r.summary["mean_left_out"][0]["id"], "50_1");
+}
+
+/// Where two JSON documents differ: structure and strings exactly, numbers to a
+/// relative 1e-12.
+fn same_numbers(a: &Value, b: &Value, at: &str, diffs: &mut Vec<String>) {
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            for k in keys {
+                same_numbers(
+                    x.get(k).unwrap_or(&Value::Null),
+                    y.get(k).unwrap_or(&Value::Null),
+                    &format!("{at}/{k}"),
+                    diffs,
+                );
+            }
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+            for (i, (p, q)) in x.iter().zip(y).enumerate() {
+                same_numbers(p, q, &format!("{at}/{i}"), diffs);
+            }
+        }
+        (Value::Number(p), Value::Number(q)) => {
+            let (p, q) = (p.as_f64().unwrap(), q.as_f64().unwrap());
+            if (p - q).abs() > 1e-12 * p.abs().max(q.abs()) {
+                diffs.push(format!("{at}: {p} ≠ {q}"));
+            }
+        }
+        _ if a == b => {}
+        _ => diffs.push(format!("{at}: {a} ≠ {b}")),
+    }
+}
+
+/// Issue #21: `rocklab --help` and every subcommand's help end with an example.
+#[test]
+fn every_help_shows_an_example() {
+    for cmd in [
+        None,
+        Some("init"),
+        Some("reduce"),
+        Some("calibrate"),
+        Some("simulate"),
+        Some("facade"),
+        Some("demo"),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_rocklab")).args(cmd).arg("--help").output().unwrap();
+        let help = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success() && help.contains("Example"), "{cmd:?}: {help}");
+        let sub = cmd.unwrap_or("reduce");
+        assert!(help.contains(&format!("rocklab {sub} ")), "{cmd:?} names no command line: {help}");
+    }
+}

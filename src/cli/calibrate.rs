@@ -17,6 +17,9 @@ use rocklab::report::campaign::Sources;
 use rocklab::report::{table::to_markdown, write_files};
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  rocklab calibrate fixtures/campaigns/one-sided-demo/campaign.toml --out out/cal\n  # writes out/cal/calibration.toml, for `simulate --calibration` and a façade study"
+)]
 pub struct CalibrateArgs {
     /// Campaign manifest.
     pub manifest: PathBuf,

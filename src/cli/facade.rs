@@ -15,8 +15,11 @@ use rocklab::report::write_files;
 use rocklab::solver::run::SolverError;
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  rocklab facade fixtures/facade/study.toml --out out/facade --samples 200 --scales 0.2:2.0:10\n  # P(overturn) per record × polarity × coefficient set, and fragility curves from the IDA"
+)]
 pub struct FacadeArgs {
-    /// Study file (TOML, see README).
+    /// Study file (TOML, docs/facade.md).
     pub study: PathBuf,
     #[arg(long)]
     pub out: PathBuf,

@@ -9,6 +9,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod calibrate;
 mod demo;
 mod facade;
+mod init;
 mod load;
 mod reduce;
 mod simulate;
@@ -17,7 +18,8 @@ mod simulate;
 #[command(
     name = "rocklab",
     version,
-    about = "Coefficients of restitution of rocking masonry walls from free-vibration tests (Giresini & Croce, COMPDYN 2021)"
+    about = "Coefficients of restitution of rocking masonry walls from free-vibration tests (Giresini & Croce, COMPDYN 2021)",
+    after_help = "Examples:\n  rocklab demo                                   # everything on the shipped fixtures → reports/demo/\n  rocklab init lab/wall-A                        # draft lab/wall-A/campaign.toml from its logs\n  rocklab reduce lab/wall-A/campaign.toml --out out/wall-A\n  rocklab calibrate lab/wall-A/campaign.toml --out out/wall-A-cal\n\nEach command's own example: rocklab help COMMAND. Documentation: README.md and docs/."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -26,6 +28,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Draft DIR/campaign.toml for a folder of logs: tests, columns, units, format detected.
+    Init(init::InitArgs),
     /// Reduce a free-vibration campaign: peaks, Eq. 3/4 coefficients, Tables 1–3, plots.
     Reduce(ReduceArgs),
     /// Fit e_in/e_out by replaying each test with the solver.
@@ -63,8 +67,11 @@ pub struct EstimatorArgs {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  rocklab reduce fixtures/campaigns/one-sided-demo/campaign.toml --out out/one-sided\n  # Tables 1–3, plots, summary.json and report.html in out/one-sided"
+)]
 pub struct ReduceArgs {
-    /// Campaign manifest (TOML, see SPEC).
+    /// Campaign manifest (TOML; docs/reduce.md; `rocklab init` drafts one).
     pub manifest: PathBuf,
     /// Output folder (created; files in it are replaced atomically).
     #[arg(long)]
@@ -74,6 +81,9 @@ pub struct ReduceArgs {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  rocklab demo                       # the fixture campaigns and the façade study → reports/demo/\n  rocklab demo --samples 20 --out /tmp/demo   # a quicker run"
+)]
 pub struct DemoArgs {
     /// Fixtures folder holding `campaigns/`.
     #[arg(long, default_value = "fixtures")]
@@ -91,6 +101,7 @@ pub struct DemoArgs {
 pub fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Init(a) => init::run(a),
         Command::Reduce(a) => reduce::run(a),
         Command::Simulate(a) => simulate::run_cli(a),
         Command::Facade(a) => facade::run(a),

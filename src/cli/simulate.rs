@@ -23,8 +23,11 @@ pub enum FormatArg {
 }
 
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Example:\n  rocklab simulate --block fixtures/facade/block.toml \\\n    --record fixtures/ground-motions/esm-central-italy-2016/IT.NRC..HGE.D.20161030.064018.C.ACC.ASC \\\n    --scale 1.27 --polarity -1 --e-in 0.59 --e-out 0.68 --out out/nrc"
+)]
 pub struct SimulateArgs {
-    /// Block file (TOML, see README).
+    /// Block file (TOML, docs/solver.md).
     #[arg(long)]
     pub block: PathBuf,
     /// Ground-motion record.

@@ -262,7 +262,9 @@ impl LogReader {
         )
     }
 
-    fn resolve_format(&self, bytes: &[u8], notes: &mut Vec<String>) -> Result<(Delimiter, Decimal), InputError> {
+    /// The delimiter and decimal mark: the manifest's, or detected from the header and
+    /// the first rows, each with a note saying which.
+    pub fn resolve_format(&self, bytes: &[u8], notes: &mut Vec<String>) -> Result<(Delimiter, Decimal), InputError> {
         let mut lines = bytes
             .split(|b| *b == b'\n')
             .map(|l| l.strip_suffix(b"\r").unwrap_or(l))

@@ -191,6 +191,8 @@ impl Campaign {
     /// Parse and validate manifest text; `path` names it in errors and resolves the
     /// test files.
     pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
+        // A manifest drafted by `rocklab init` and not yet filled in.
+        super::scaffold::check_filled(text, path)?;
         validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
     }
 }

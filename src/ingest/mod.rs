@@ -8,6 +8,7 @@ pub mod log;
 pub mod manifest;
 pub mod record;
 pub mod reduce;
+pub mod scaffold;
 pub mod study;
 pub mod text;
 

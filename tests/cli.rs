@@ -793,3 +793,63 @@ fn every_help_shows_an_example() {
         assert!(help.contains(&format!("rocklab {sub} ")), "{cmd:?} names no command line: {help}");
     }
 }
+
+/// Issue #21: report.html names each suspect reason once (in its quality section,
+/// with what to do), not in every table; the tables carry a short mark. The test
+/// is seed 1000 of the compliant random draw, suspect for four kinds of reason
+/// (`tests/suspect_reasons.rs`, `suspect_seeds`).
+#[test]
+fn report_html_says_each_suspect_reason_once() {
+    use rocklab::synth::{draw, Family};
+    let s = draw(1000, Family::Compliant);
+    let dir = tempfile::tempdir().unwrap();
+    let mut log = String::from("time_s,disp_mm\n");
+    for (t, x) in s.t.iter().zip(&s.x_mm) {
+        log.push_str(&format!("{t},{x}\n"));
+    }
+    std::fs::write(dir.path().join("s1000.csv"), log).unwrap();
+    let manifest = dir.path().join("campaign.toml");
+    std::fs::write(
+        &manifest,
+        format!(
+            "[campaign]\nname = \"draw\"\nrocking = \"{}\"\n[wall]\nheight_m = {}\nthickness_m = {}\nhinge_height_m = 0.0\n[channels]\ntime = {{ column = \"time_s\", unit = \"s\" }}\ndisplacement = {{ column = \"disp_mm\", unit = \"mm\", height_m = {} }}\n[[test]]\nid = \"s1000\"\nfile = \"s1000.csv\"\n",
+            if s.spec.one_sided() { "one-sided" } else { "two-sided" },
+            s.spec.height_m,
+            s.spec.thickness_m,
+            s.spec.lever_mm / 1000.0
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .arg("reduce")
+        .arg(&manifest)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let t = test_entry(&summary, "s1000");
+    assert_eq!(t["status"], "suspect", "{t}");
+    let reasons: Vec<String> = t["reason"].as_str().unwrap().split("; ").map(str::to_string).collect();
+    assert!(reasons.len() >= 2, "{reasons:?}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    for r in &reasons {
+        let shown = rocklab::report::html::escape(r);
+        assert_eq!(
+            html.matches(&shown).count(),
+            1,
+            "reason shown {} times: {r}",
+            html.matches(&shown).count()
+        );
+        let advice = rocklab::report::quality::advice(rocklab::report::quality::kind(r));
+        assert_ne!(advice, rocklab::report::quality::advice(rocklab::report::quality::Kind::Other), "{r}");
+        assert!(html.contains(&rocklab::report::html::escape(advice.rerun)), "no advice for {r}");
+    }
+    // The tables' quality cells are the short mark, and link nowhere else.
+    assert_eq!(html.matches("<td class=\"suspect l\">suspect</td>").count(), 3, "one mark per table");
+    assert!(html.contains("id=\"quality-s1000\"") && html.contains("href=\"#plots-s1000\""));
+    // The CSV keeps the whole reason.
+    assert!(std::fs::read_to_string(out.join("table1.csv")).unwrap().contains(&reasons[0]));
+}

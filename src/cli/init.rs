@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::Args;
 use rocklab::ingest::scaffold::{manifest_text, survey_dir, FILL_IN};
+use rocklab::report::{write_files, Files};
 
 use super::say;
 
@@ -46,7 +47,9 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
         .unwrap_or_else(|| "campaign".into());
     let text = manifest_text(&name, &logs, &skipped);
-    rocklab::atomic::write_atomic(&path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+    let mut files = Files::default();
+    files.add("campaign.toml", text.as_bytes());
+    write_files(&a.dir, &files).with_context(|| format!("writing {}", path.display()))?;
     say(&format!("wrote {} ({} tests)", path.display(), logs.len()));
     for s in &skipped {
         say(&format!("  not drafted: {}: {}", s.file, s.reason));

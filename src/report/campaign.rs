@@ -4,10 +4,12 @@
 
 use rayon::prelude::*;
 
-use super::html::Page;
+use super::html::{escape, Page};
 use super::plots::{self, Figure, Panel, Series};
+use super::quality::{advice, kind};
 use super::tables::{self, to_html, Table};
 use super::{Files, InputFile, ReportError};
+use crate::peaks::Quality;
 use crate::reduce::{CampaignResult, Reduced};
 use crate::restitution::local_ratios;
 
@@ -143,15 +145,6 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
         c.e_housner_source,
         res.options.method.describe()
     ));
-    let failed: Vec<_> = res.failed().collect();
-    if !failed.is_empty() {
-        page.h2("Tests that could not be reduced");
-        page.table(
-            "meta",
-            &["test", "reason"],
-            &failed.iter().map(|(id, e)| vec![id.to_string(), e.to_string()]).collect::<Vec<_>>(),
-        );
-    }
     page.h2("Tables");
     if !res.means.left_out.is_empty() {
         page.p(&format!("Means leave out: {}.", res.means.left_out_text()));
@@ -159,13 +152,17 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
     for t in tabs {
         page.raw(&to_html(t));
     }
+    quality_section(&mut page, res, !figs.is_empty());
     page.h2("Velocity peaks");
     let mut rows = Vec::new();
     for t in &res.tests {
         if let Ok(r) = &t.result {
             rows.push(
                 std::iter::once(t.spec.id.clone())
-                    .chain(r.analysis.peaks.iter().map(|p| format!("{:.1} @ {:.3} s", p.velocity_mm_s, p.time_s)))
+                    .chain(r.analysis.peaks.iter().map(|p| match p.velocity_u_mm_s {
+                        Some(u) => format!("{:.1} ± {u:.1} @ {:.3} s", p.velocity_mm_s, p.time_s),
+                        None => format!("{:.1} @ {:.3} s", p.velocity_mm_s, p.time_s),
+                    }))
                     .collect(),
             );
         }
@@ -176,7 +173,7 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
     }
     page.h2("Plots");
     for (id, motion, ratios) in figs {
-        page.h3(&format!("Test {id}"));
+        page.raw(&format!("<h3 id=\"plots-{0}\">Test {0}</h3>\n", escape(id)));
         page.figure(
             &motion.svg,
             &format!("Test {id}: displacement and velocity with the velocity peaks marked (paper Fig. 3/4)."),
@@ -185,6 +182,61 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
     }
     provenance(&mut page, res, sources);
     page.finish()
+}
+
+/// The quality section: each test the tool cannot vouch for, once, with its
+/// reasons in the lab's words ([`super::quality`]): what is wrong, the plot to look
+/// at, how far off the values may be, what to re-run; then the estimator's own
+/// words. Tests that could not be reduced are listed with their error.
+fn quality_section(page: &mut Page, res: &CampaignResult, with_plots: bool) {
+    page.h2("Quality");
+    let suspect: Vec<(&str, &[String])> = res
+        .tests
+        .iter()
+        .filter_map(|t| match &t.result.as_ref().ok()?.analysis.quality {
+            Quality::Suspect(reasons) => Some((t.spec.id.as_str(), reasons.as_slice())),
+            Quality::Ok => None,
+        })
+        .collect();
+    let failed: Vec<_> = res.failed().collect();
+    if suspect.is_empty() && failed.is_empty() {
+        page.p("Every test passed the estimator's checks (docs/estimator.md): the tables' ± are their standard uncertainties.");
+        return;
+    }
+    page.p("A suspect test is left out of the means. Its values are in the tables, but the estimator cannot vouch for them:");
+    let mut html = String::from("<dl class=\"quality\">\n");
+    for (id, reasons) in &suspect {
+        let plot = if with_plots {
+            format!("<a href=\"#plots-{0}\">plots/{0}_motion</a>", escape(id))
+        } else {
+            format!("plots/{}_motion (not drawn: --no-plots)", escape(id))
+        };
+        html.push_str(&format!("<dt id=\"quality-{0}\" data-test=\"{0}\">{0}: suspect</dt>\n", escape(id)));
+        let mut kinds: Vec<_> = reasons.iter().map(|r| kind(r)).collect();
+        kinds.sort();
+        kinds.dedup();
+        for k in kinds {
+            let a = advice(k);
+            let details: Vec<String> = reasons.iter().filter(|r| kind(r) == k).map(|r| escape(r)).collect();
+            html.push_str(&format!(
+                "<dd><strong>{}</strong> Look at {plot}: {} <em>How far off:</em> {} <em>What to do:</em> {}<br><span class=\"detail\">The estimator: {}.</span></dd>\n",
+                escape(a.title),
+                escape(a.look),
+                escape(a.how_far),
+                escape(a.rerun),
+                details.join("; ")
+            ));
+        }
+    }
+    for (id, e) in &failed {
+        html.push_str(&format!(
+            "<dt id=\"quality-{0}\" data-test=\"{0}\">{0}: not reduced</dt>\n<dd>{1}<br>Fix the log or the manifest at the place named and run reduce again.</dd>\n",
+            escape(id),
+            escape(&e.to_string())
+        ));
+    }
+    html.push_str("</dl>\n");
+    page.raw(&html);
 }
 
 /// The provenance section of the reduce report: the inputs with their checksums,

@@ -19,6 +19,8 @@ tr.mean td { border-top: 1px solid #222; font-weight: bold; } td.error { color: 
 figure { margin: 0.8em 0; page-break-inside: avoid; } figure svg { width: 100%; height: auto; } figcaption { font-size: 9pt; }
 pre { background: #f4f4f4; padding: 0.6em; font-size: 8.5pt; white-space: pre-wrap; } .meta td, .meta th { font-size: 9pt; overflow-wrap: anywhere; } .meta td:first-child { overflow-wrap: normal; } .peaks td { white-space: nowrap; } .peaks td, .peaks th { padding: 0.15em 0.45em; }
 .warn { color: #8a5a00; }
+td[data-value], td.ok, td.suspect, td.error { white-space: nowrap; }
+.quality dt { font-weight: bold; margin-top: 0.6em; } .quality dd { margin: 0.2em 0 0.2em 1.5em; } .quality .detail { color: #555; font-size: 9pt; }
 @page { size: A4; margin: 15mm; }
 @media print { body { max-width: none; margin: 0; } h2 { page-break-after: avoid; } }
 "#;

@@ -10,6 +10,7 @@ pub mod docs;
 pub mod facade;
 pub mod html;
 pub mod plots;
+pub mod quality;
 pub mod response;
 pub mod summary;
 pub mod table;

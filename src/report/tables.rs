@@ -1,7 +1,8 @@
 //! Tables 1–3 in the paper's layout, built on the one table model
 //! ([`super::table`]): CSV at full precision (values, their standard
-//! uncertainties, the status), Markdown and HTML in percent rounded like the paper
-//! with a quality column, LaTeX with a dagger on suspect tests.
+//! uncertainties, the status with its reason), Markdown and HTML in percent rounded
+//! like the paper with a quality column (HTML: a short mark, the reasons are in the
+//! page's quality section), LaTeX with a dagger on suspect tests.
 
 pub use super::table::{latex_escape, to_csv, to_html, to_latex, to_markdown, Table};
 use super::table::{Align, Cell, Column, CsvField};
@@ -48,10 +49,13 @@ fn test_row(cols: Cols, id: &str, values: Result<(&Coefficients, Option<&Coeffic
             if suspect.is_some() {
                 cells[0].tex = Some(format!("{}$^\\dagger$", latex_escape(id)));
             }
+            // HTML shows a short mark (the page explains the reasons once, in its
+            // quality section); CSV keeps the whole reason, Markdown its first words.
             cells.push(match suspect {
                 Some(why) => Cell {
                     md: Some(format!("suspect: {}", first_words(&why))),
-                    ..Cell::text(format!("suspect: {why}")).class("suspect")
+                    csv: Some(format!("suspect: {why}")),
+                    ..Cell::text("suspect").class("suspect")
                 },
                 None => Cell::text("ok").class("ok"),
             });
@@ -65,7 +69,8 @@ fn test_row(cols: Cols, id: &str, values: Result<(&Coefficients, Option<&Coeffic
             }
             cells.push(Cell {
                 md: Some(format!("error: {}", first_words(e))),
-                ..Cell::text(format!("error: {e}")).class("error")
+                csv: Some(format!("error: {e}")),
+                ..Cell::text("error").class("error")
             });
         }
     }

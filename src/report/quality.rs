@@ -1,0 +1,175 @@
+//! What a suspect test means to the engineer who has to act on it. The estimator's
+//! checks ([`crate::peaks::checks`]) say in its own words why it cannot vouch for a
+//! fit; each reason is sorted here into a [`Kind`], and each kind says in the lab's
+//! words what went wrong, which plot shows it, how far off the values may be (as
+//! measured on the random draws of `tests/suspect_reasons.rs`, see
+//! docs/accuracy.md) and what to re-run. The report prints a test's reasons once,
+//! in its quality section; the tables carry a short mark.
+
+/// The kinds of suspect reasons, one per check of [`crate::peaks::checks`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Kind {
+    MergedImpacts,
+    Alternation,
+    EnergyGain,
+    ImpactGainsSpeed,
+    Misfit,
+    ImpactResiduals,
+    Disagreement,
+    LongContact,
+    ContactOvershoot,
+    ZeroReadings,
+    /// A reason this module does not know (a new check): shown as the estimator says it.
+    Other,
+}
+
+/// The phrase each check's reason ends with.
+const PHRASES: &[(&str, Kind)] = &[
+    ("the fit merged two impacts", Kind::MergedImpacts),
+    ("the peaks do not alternate", Kind::Alternation),
+    ("free rocking cannot gain energy", Kind::EnergyGain),
+    ("the fit cannot place this impact", Kind::ImpactGainsSpeed),
+    ("the fit misses the log", Kind::Misfit),
+    ("the impact is not where the fit puts it", Kind::ImpactResiduals),
+    ("the two estimates disagree", Kind::Disagreement),
+    ("the contact model does not describe this log", Kind::LongContact),
+    ("the contact model overshoots", Kind::ContactOvershoot),
+    ("does not settle where the half-cycle ends", Kind::ZeroReadings),
+];
+
+/// The kind of one reason of the estimator.
+pub fn kind(reason: &str) -> Kind {
+    PHRASES.iter().find(|(p, _)| reason.contains(p)).map_or(Kind::Other, |(_, k)| *k)
+}
+
+/// The reasons of a suspect test as the estimator joins them ("a; b; c"). A reason
+/// never holds "; " itself.
+pub fn split(reasons: &str) -> Vec<&str> {
+    reasons.split("; ").map(str::trim).filter(|r| !r.is_empty()).collect()
+}
+
+/// What a kind of reason means, in the lab's words.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Advice {
+    /// One line: what is wrong.
+    pub title: &'static str,
+    /// Which plot of the test shows it, and what to look for.
+    pub look: &'static str,
+    /// How far off the values may be.
+    pub how_far: &'static str,
+    /// What to change and re-run.
+    pub rerun: &'static str,
+}
+
+const NOT_MEASURED: &str = "Not measured: no test of the random draws tripped this check. Do not use the values until the plot is explained.";
+
+/// The advice for a kind of reason.
+pub fn advice(kind: Kind) -> Advice {
+    match kind {
+        Kind::MergedImpacts => Advice {
+            title: "Two impacts run into one: the fit found two impacts less than two samples apart.",
+            look: "the velocity panel of the motion plot, at the impact named: is there one jump or two?",
+            how_far: NOT_MEASURED,
+            rerun: "log at a higher rate if the wall rattles; else compare with `rocklab reduce --method savgol`.",
+        },
+        Kind::Alternation => Advice {
+            title: "The velocity peaks do not alternate inward, outward: a half-cycle was missed or invented.",
+            look: "the velocity panel of the motion plot: count the half-cycles against the red dots.",
+            how_far: NOT_MEASURED,
+            rerun: "check outward_sign and the displacement column in the manifest; trim a log that starts before the release.",
+        },
+        Kind::EnergyGain => Advice {
+            title: "A velocity peak is faster than the one before: a free-rocking wall cannot gain energy.",
+            look: "the velocity panel of the motion plot, at the peak named, and the ratios plot (a ratio above 1).",
+            how_far: "Not measured on the random draws (no test tripped it). The ratio across that peak comes out above 1, which no impact gives: do not use the values that involve it.",
+            rerun: "check that nothing pushed the wall during the test; re-run with `--method savgol` to compare.",
+        },
+        Kind::ImpactGainsSpeed => Advice {
+            title: "An impact leaves the wall faster than it found it (e > 1): the fit has the impact's time wrong.",
+            look: "the displacement panel of the motion plot around the impact named: a rounded, slow contact.",
+            how_far: NOT_MEASURED,
+            rerun: "a higher logging rate resolves the contact; at the same rate compare with `--method savgol`.",
+        },
+        Kind::Misfit => Advice {
+            title: "The model does not follow the log: the residuals are several times the sensor's noise.",
+            look: "the displacement panel of the motion plot: where does the red fit leave the grey log?",
+            how_far: "On 200 synthetic tests with compliant contacts, the 7 flagged for this were off by 6.75 pp at the median and 10.82 pp at worst (the worst of the seven values of each test): do not use the values.",
+            rerun: "check the wall's geometry and hinge height in [wall], and the sensor's height; a log with drift or a moving base needs trimming.",
+        },
+        Kind::ImpactResiduals => Advice {
+            title: "The log around an impact is not where the fit puts it.",
+            look: "the displacement panel of the motion plot, zoomed on the impact named.",
+            how_far: "On 200 synthetic tests with compliant contacts, the 14 flagged for this were off by 2.33 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
+            rerun: "look for a spike or a dropout near the impact in the raw log; a higher logging rate helps.",
+        },
+        Kind::Disagreement => Advice {
+            title: "Two ways of reading a peak disagree: the whole-record fit and a fit of that half-cycle alone.",
+            look: "the velocity panel of the motion plot at the peak named: does the blue fit follow the grey velocity into the impact?",
+            how_far: "Not measured on the random draws (no test tripped it). The reason gives both readings: the peak may lie anywhere between them, and the ratios that use it move with it.",
+            rerun: "compare with `rocklab reduce --method savgol`; a higher logging rate narrows the disagreement.",
+        },
+        Kind::LongContact => Advice {
+            title: "The contact at an impact lasts too long for an impact: the wall is not rocking freely there.",
+            look: "the displacement panel of the motion plot around the impact named: a slow, rounded turn instead of a kink.",
+            how_far: "On 200 synthetic tests with compliant contacts, the 12 flagged for this were off by 3.06 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
+            rerun: "check that the wall is free to rock (no mortar bridge or friction at the hinge); trim the log to the clean impacts.",
+        },
+        Kind::ContactOvershoot => Advice {
+            title: "Inside a contact the fitted speed overshoots the free swing: the contact model does not fit this impact.",
+            look: "the velocity panel of the motion plot at the peak named: is the blue curve above the grey one?",
+            how_far: "On 200 synthetic tests with compliant contacts, the 7 flagged for this were off by 2.33 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
+            rerun: "compare with `rocklab reduce --method savgol`; a higher logging rate resolves the contact.",
+        },
+        Kind::ZeroReadings => Advice {
+            title: "The peak depends on where the wall's rest position is taken: the fitted zero and the final rest differ.",
+            look: "the displacement panel of the motion plot: is the final rest level with the zero the fit crosses?",
+            how_far: "Not measured on the random draws (no test tripped it). The peak moves by the amount the reason gives (more than 20 % of it) between the two readings; the ratios that use it may be off by as much.",
+            rerun: "log a longer rest after the wall stops, so the rest line is well defined.",
+        },
+        Kind::Other => Advice {
+            title: "The estimator cannot vouch for this test.",
+            look: "the motion and ratios plots of the test.",
+            how_far: NOT_MEASURED,
+            rerun: "compare with `rocklab reduce --method savgol`.",
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::peaks::checks;
+
+    /// Every check's reason is sorted into its own kind: a reworded reason fails
+    /// here instead of falling through to `Other` in the report.
+    #[test]
+    fn every_check_has_its_kind() {
+        let cases = [
+            (checks::merged_impacts(&[1.0, 1.001], 0.005), Kind::MergedImpacts),
+            (checks::alternation(&[-5.0, -4.0]), Kind::Alternation),
+            (checks::energy_gain(&[-5.0, 9.0], &[0.0, 0.0]), Kind::EnergyGain),
+            (checks::impact_gains_speed(&[-5.0], &[Some(9.0)], &[0.0, 0.0]), Kind::ImpactGainsSpeed),
+            (checks::misfit(&[1.0, -1.0, 1.0, -1.0], 0.01), Kind::Misfit),
+            (
+                checks::structured_near_impacts(&[0.99, 1.0, 1.01], &[1.0, -1.0, 1.0], &[1.0], 0.01, 0.01),
+                Kind::ImpactResiduals,
+            ),
+            (checks::disagreement(&[-100.0], &[0.1], &[Some((-50.0, 0.1))]), Kind::Disagreement),
+            (checks::contact_too_long(&[(0.05, 0.05)], &[0.1, 0.1], &[false, false]), Kind::LongContact),
+            (checks::contact_overshoot(&[-100.0], &[-50.0], &[0.1], &[false]), Kind::ContactOvershoot),
+            (checks::zero_readings_disagree(&[-100.0], &[40.0]), Kind::ZeroReadings),
+        ];
+        for (reason, want) in cases {
+            let reason = reason.unwrap_or_else(|| panic!("the {want:?} case does not trip its check"));
+            assert_eq!(kind(&reason), want, "{reason}");
+            assert!(!reason.contains("; "), "a reason holds the separator: {reason}");
+        }
+        assert_eq!(kind("something new"), Kind::Other);
+    }
+
+    #[test]
+    fn reasons_split_on_the_estimators_separator() {
+        assert_eq!(split("a: b; c"), vec!["a: b", "c"]);
+        assert!(split("").is_empty());
+    }
+}

@@ -153,21 +153,7 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
         page.raw(&to_html(t));
     }
     quality_section(&mut page, res, !figs.is_empty());
-    page.h2("Velocity peaks");
-    let mut rows = Vec::new();
-    for t in &res.tests {
-        if let Ok(r) = &t.result {
-            rows.push(
-                std::iter::once(t.spec.id.clone())
-                    .chain(r.analysis.peaks.iter().map(|p| match p.velocity_u_mm_s {
-                        Some(u) => format!("{:.1} ± {u:.1} @ {:.3} s", p.velocity_mm_s, p.time_s),
-                        None => format!("{:.1} @ {:.3} s", p.velocity_mm_s, p.time_s),
-                    }))
-                    .collect(),
-            );
-        }
-    }
-    page.table("meta peaks", &["test", "v0 (mm/s)", "v1", "v2", "v3", "v4", "v5"], &rows);
+    peaks_section(&mut page, res);
     for x in extra {
         page.raw(x);
     }
@@ -182,6 +168,36 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
     }
     provenance(&mut page, res, sources);
     page.finish()
+}
+
+/// The velocity peaks v_k with their standard uncertainties (mm/s), and their
+/// times (s) in a table of their own, so that every cell stays on one line.
+fn peaks_section(page: &mut Page, res: &CampaignResult) {
+    page.h2("Velocity peaks");
+    let reduced: Vec<(&str, &Reduced)> = res
+        .tests
+        .iter()
+        .filter_map(|t| Some((t.spec.id.as_str(), t.result.as_ref().ok()?)))
+        .collect();
+    let row = |id: &str, cells: Vec<String>| std::iter::once(id.to_string()).chain(cells).collect::<Vec<String>>();
+    let velocities: Vec<Vec<String>> = reduced
+        .iter()
+        .map(|(id, r)| {
+            let v = r.analysis.peaks.iter().map(|p| match p.velocity_u_mm_s {
+                Some(u) => format!("{:.1} ± {u:.1}", p.velocity_mm_s),
+                None => format!("{:.1}", p.velocity_mm_s),
+            });
+            row(id, v.collect())
+        })
+        .collect();
+    let times: Vec<Vec<String>> = reduced
+        .iter()
+        .map(|(id, r)| row(id, r.analysis.peaks.iter().map(|p| format!("{:.3}", p.time_s)).collect()))
+        .collect();
+    page.p("Each peak v_k ± its standard uncertainty (outward +), in mm/s:");
+    page.table("meta peaks", &["test", "v0", "v1", "v2", "v3", "v4", "v5"], &velocities);
+    page.p("and the time of each peak, s:");
+    page.table("meta peaks", &["test", "t0", "t1", "t2", "t3", "t4", "t5"], &times);
 }
 
 /// The quality section: each test the tool cannot vouch for, once, with its
@@ -219,7 +235,7 @@ fn quality_section(page: &mut Page, res: &CampaignResult, with_plots: bool) {
             let a = advice(k);
             let details: Vec<String> = reasons.iter().filter(|r| kind(r) == k).map(|r| escape(r)).collect();
             html.push_str(&format!(
-                "<dd><strong>{}</strong> Look at {plot}: {} <em>How far off:</em> {} <em>What to do:</em> {}<br><span class=\"detail\">The estimator: {}.</span></dd>\n",
+                "<dd><strong>{}</strong><br><em>Look at</em> {plot}: {}<br><em>How far off:</em> {}<br><em>What to do:</em> {}<br><span class=\"detail\">The estimator: {}.</span></dd>\n",
                 escape(a.title),
                 escape(a.look),
                 escape(a.how_far),

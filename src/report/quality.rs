@@ -70,7 +70,7 @@ pub fn advice(kind: Kind) -> Advice {
             title: "Two impacts run into one: the fit found two impacts less than two samples apart.",
             look: "the velocity panel of the motion plot, at the impact named: is there one jump or two?",
             how_far: NOT_MEASURED,
-            rerun: "log at a higher rate if the wall rattles; else compare with `rocklab reduce --method savgol`.",
+            rerun: "log at a higher rate if the wall rattles; else compare with rocklab reduce --method savgol.",
         },
         Kind::Alternation => Advice {
             title: "The velocity peaks do not alternate inward, outward: a half-cycle was missed or invented.",
@@ -106,7 +106,7 @@ pub fn advice(kind: Kind) -> Advice {
             title: "Two ways of reading a peak disagree: the whole-record fit and a fit of that half-cycle alone.",
             look: "the velocity panel of the motion plot at the peak named: does the blue fit follow the grey velocity into the impact?",
             how_far: "Not measured on the random draws (no test tripped it). The reason gives both readings: the peak may lie anywhere between them, and the ratios that use it move with it.",
-            rerun: "compare with `rocklab reduce --method savgol`; a higher logging rate narrows the disagreement.",
+            rerun: "compare with rocklab reduce --method savgol; a higher logging rate narrows the disagreement.",
         },
         Kind::LongContact => Advice {
             title: "The contact at an impact lasts too long for an impact: the wall is not rocking freely there.",
@@ -118,7 +118,7 @@ pub fn advice(kind: Kind) -> Advice {
             title: "Inside a contact the fitted speed overshoots the free swing: the contact model does not fit this impact.",
             look: "the velocity panel of the motion plot at the peak named: is the blue curve above the grey one?",
             how_far: "On 200 synthetic tests with compliant contacts, the 7 flagged for this were off by 2.33 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
-            rerun: "compare with `rocklab reduce --method savgol`; a higher logging rate resolves the contact.",
+            rerun: "compare with rocklab reduce --method savgol; a higher logging rate resolves the contact.",
         },
         Kind::ZeroReadings => Advice {
             title: "The peak depends on where the wall's rest position is taken: the fitted zero and the final rest differ.",
@@ -130,7 +130,7 @@ pub fn advice(kind: Kind) -> Advice {
             title: "The estimator cannot vouch for this test.",
             look: "the motion and ratios plots of the test.",
             how_far: NOT_MEASURED,
-            rerun: "compare with `rocklab reduce --method savgol`.",
+            rerun: "compare with rocklab reduce --method savgol.",
         },
     }
 }

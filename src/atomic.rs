@@ -1,7 +1,7 @@
 //! Atomic file output: write to a temporary file in the same folder, then rename,
 //! so a reader never sees a half-written file. [`write_under`] also refuses a
 //! relative path that would leave its root (issue 22: defence in depth behind
-//! the sanitised names of [`crate::report::file_stem`]).
+//! the sanitised names of the report's `file_stem`).
 
 use std::io::Write;
 use std::path::{Component, Path};

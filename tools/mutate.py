@@ -223,13 +223,22 @@ def non_finite(path):
     if ext not in (".csv", ".md", ".tex", ".html", ".svg"):
         return None
     text = data.decode("utf-8", "replace")
+    # Where numbers are written: CSV fields, table cells (Markdown |, LaTeX &,
+    # HTML <td>), SVG attribute values; not prose, labels or echoed inputs.
     for i, line in enumerate(text.splitlines()):
         if ext == ".csv":
-            if any(f.strip().strip('"').lstrip("+-").lower() in ("nan", "inf", "infinity") for f in line.split(",")):
+            cells = [f.strip('"') for f in line.split(",")]
+        elif ext == ".md":
+            cells = line.split("|") if line.lstrip().startswith("|") else []
+        elif ext == ".tex":
+            cells = [c.strip().rstrip("\\") for c in line.split("&")] if "&" in line else []
+        elif ext == ".html":
+            cells = re.findall(r"<td[^>]*>(.*?)</td>", line)
+        else:
+            cells = [w for v in line.split('"')[1::2] for w in re.split(r"[ ,]", v)]
+        for c in cells:
+            if re.match(r"^[-+−]?(nan|infinity|inf)($|[ %$°])", c.strip().lower()):
                 return f"line {i + 1}: {line[:80]}"
-        # A word NaN/inf, unless quoted (an error message quoting the bad cell).
-        elif re.search(r"(?<![\w'\"‘“;])(NaN|inf)(?![\w'\"’”&])", line):
-            return f"line {i + 1}: {line[:80]}"
     return None
 
 
@@ -282,11 +291,14 @@ def run_case(seed, i):
 
 
 def main():
+    global BIN
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=int, default=2022)
     ap.add_argument("--n", type=int, default=1500)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--bin", type=Path, default=BIN, help="the binary to run (default target/release/rocklab)")
     a = ap.parse_args()
+    BIN = a.bin
     if not BIN.exists():
         sys.exit(f"{BIN} not found: cargo build --release")
     counts = {"cases": 0, "exit0": 0, "exit2": 0, "other_exit": 0, "crash": 0, "hang": 0, "nonfinite": 0, "escape": 0,

@@ -353,6 +353,15 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
             format!("{where_}sensor height {sensor_h} m is not above the hinge ({} m)", d.hinge_height_m),
         ));
     }
+    if t.file.len() > 4096 || Path::new(&t.file).components().any(|c| c.as_os_str().len() > 255) {
+        return Err(bad(
+            path,
+            format!(
+                "{where_}file = \"{}\": expected a path of at most 4096 bytes, 255 per name",
+                crate::error::excerpt(&t.file, 60)
+            ),
+        ));
+    }
     let format = match &t.format {
         Some(f) => parse_format(path, &format!("{where_}format."), f)?,
         None => d.format,

@@ -33,23 +33,31 @@ pub fn check_serialize<T: Serialize + ?Sized>(doc: &T) -> Result<(), NonFinite> 
     doc.serialize(&mut w)
 }
 
-/// Fails naming the line (and field, for a CSV) of the first non-finite number
-/// spelled in the text of `name`; binary files (PNG) and unknown kinds pass.
+/// Fails naming the line and the field of the first non-finite number written
+/// where numbers are written in a text output of `name`: a CSV field, a table
+/// cell of Markdown (`|`), LaTeX (`&`) or HTML (`<td>`), an SVG attribute value (a
+/// coordinate). Prose, captions, SVG labels and the echoed inputs are not numbers
+/// (a test or a record may be named "inf"; a manifest comment may say NaN);
+/// binary files (PNG) and other kinds pass.
 pub fn check_bytes(name: &str, bytes: &[u8]) -> Result<(), NonFinite> {
     let ext = name.rsplit('.').next().unwrap_or("");
-    if !matches!(ext, "csv" | "md" | "tex" | "html" | "svg" | "toml" | "txt") {
-        return Ok(());
-    }
     let text = String::from_utf8_lossy(bytes);
     for (i, line) in text.lines().enumerate() {
-        let hit = if ext == "csv" {
-            line.split(',').position(|f| non_finite_word(f.trim().trim_matches('"')))
-        } else {
-            rust_non_finite_word(line)
+        let cells: Vec<&str> = match ext {
+            "csv" => line.split(',').map(|f| f.trim_matches('"')).collect(),
+            "md" if line.trim_start().starts_with('|') => line.split('|').collect(),
+            "tex" if line.contains('&') => line.split('&').map(|c| c.trim().trim_end_matches("\\\\")).collect(),
+            "html" => line
+                .split("<td")
+                .skip(1)
+                .filter_map(|c| c.split_once('>').map(|(_, r)| r.split("</td>").next().unwrap_or(r)))
+                .collect(),
+            "svg" => line.split('"').skip(1).step_by(2).flat_map(|v| v.split([' ', ','])).collect(),
+            _ => Vec::new(),
         };
-        if let Some(k) = hit {
+        if let Some(k) = cells.iter().position(|c| non_finite_cell(c)) {
             return Err(NonFinite(format!(
-                "{name}:{}: a non-finite number (field/word {}) would be written",
+                "{name}:{}: a non-finite number (field {}) would be written",
                 i + 1,
                 k + 1
             )));
@@ -58,40 +66,15 @@ pub fn check_bytes(name: &str, bytes: &[u8]) -> Result<(), NonFinite> {
     Ok(())
 }
 
-/// A CSV field that a reader parses as NaN or an infinity.
-fn non_finite_word(f: &str) -> bool {
-    let f = f.strip_prefix(['-', '+']).unwrap_or(f).to_ascii_lowercase();
-    matches!(f.as_str(), "nan" | "inf" | "infinity")
-}
-
-/// The index (1-based count of words) of a word that Rust's `Display` writes for a
-/// non-finite f64 (`NaN`, `inf`, `-inf`), unless quoted: an error message that
-/// quotes the bad cell of an input ('NaN' is not a finite number) is not a number
-/// written (quotes as they are or HTML-escaped: `'`, `"`, `‘’`, `“”`, `&#39;`, `&quot;`).
-fn rust_non_finite_word(line: &str) -> Option<usize> {
-    let is_word = |c: char| c.is_alphanumeric() || c == '_';
-    let opening = |c: Option<char>| matches!(c, Some('\'' | '"' | '‘' | '“' | ';'));
-    let closing = |c: Option<char>| matches!(c, Some('\'' | '"' | '’' | '”' | '&'));
-    let mut k = 0;
-    let mut start = None;
-    let chars: Vec<(usize, char)> = line.char_indices().collect();
-    for (j, &(i, c)) in chars.iter().enumerate().chain(std::iter::once((chars.len(), &(line.len(), ' ')))) {
-        match (is_word(c) && i < line.len(), start) {
-            (true, None) => start = Some(j),
-            (false, Some(s)) => {
-                k += 1;
-                let word = &line[chars[s].0..i];
-                let before = s.checked_sub(1).map(|b| chars[b].1);
-                let after = chars.get(j).map(|x| x.1);
-                if (word == "NaN" || word == "inf") && !(opening(before) && closing(after)) {
-                    return Some(k - 1);
-                }
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    None
+/// A cell that reads as NaN or an infinity (`NaN`, `inf`, `-inf`, `Infinity`, any
+/// case; in a cell, with what may follow a number: a unit, a `%`, a `±`).
+fn non_finite_cell(c: &str) -> bool {
+    let c = c.trim();
+    let c = c.strip_prefix(['-', '+', '−']).unwrap_or(c).to_ascii_lowercase();
+    ["nan", "infinity", "inf"].iter().any(|w| {
+        c.strip_prefix(w)
+            .is_some_and(|rest| rest.is_empty() || rest.starts_with([' ', '%', '$', '°']))
+    })
 }
 
 struct Walker {
@@ -306,17 +289,22 @@ mod tests {
     }
 
     #[test]
-    fn finds_non_finite_words_in_text_outputs() {
+    fn finds_non_finite_numbers_where_text_outputs_write_numbers() {
         assert!(check_bytes("a.csv", b"t,theta\n0,1e-3\n").is_ok());
         assert!(check_bytes("a.csv", b"t,theta\n0,NaN\n").unwrap_err().0.starts_with("a.csv:2: "));
         assert!(check_bytes("a.csv", b"t,theta\n0,-inf\n").is_err());
         assert!(check_bytes("a.svg", b"<path d=\"M 1 NaN\"/>").is_err());
+        assert!(check_bytes("a.svg", b"<polyline points=\"1,2 3,inf\"/>").is_err());
         assert!(check_bytes("a.md", b"| x | inf |").is_err());
-        assert!(check_bytes("a.html", b"<p>information, infinite, Nancy</p>").is_ok());
+        assert!(check_bytes("a.md", b"| x | -inf % |").is_err());
+        assert!(check_bytes("a.tex", b"x & NaN \\\\").is_err());
+        assert!(check_bytes("a.html", b"<tr><td class=\"n\">inf</td></tr>").is_err());
         assert!(check_bytes("a.png", b"NaN").is_ok());
-        // An error message quoting a bad input cell is not a number written.
-        assert!(check_bytes("t.md", "| bad | error: 'NaN' is not a finite number |".as_bytes()).is_ok());
+        // Names, prose, labels, echoed inputs and quoted bad cells are not numbers.
+        assert!(check_bytes("a.html", b"<p>information, infinite, Nancy; width_m = inf</p>").is_ok());
+        assert!(check_bytes("a.svg", b"<text x=\"1\">inf</text>").is_ok());
+        assert!(check_bytes("t.md", "| inf_1 | error: 'NaN' is not a finite number |".as_bytes()).is_ok());
+        assert!(check_bytes("t.tex", b"inf\\_1 & 64 \\\\").is_ok());
         assert!(check_bytes("t.html", b"<td>&#39;inf&#39; is not a finite number</td>").is_ok());
-        assert!(check_bytes("t.md", b"| x | -inf |").is_err());
     }
 }

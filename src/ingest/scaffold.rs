@@ -131,16 +131,26 @@ pub fn survey_log(name: &str, bytes: &[u8]) -> Result<LogSurvey, String> {
         || columns.iter().find(|c| *c != time_col).cloned().unwrap_or_default(),
         |d| d.column.clone(),
     );
-    let to_s = if time.unit == Some("ms") { 1e-3 } else { 1.0 };
-    let data = LogReader::new(name)
-        .format(LogFormat {
-            delimiter: Some(delimiter),
-            decimal: Some(decimal),
-        })
-        .time(&time.column, to_s)
-        .displacement(&disp_col, 1.0)
-        .parse(bytes)
-        .map_err(|e| e.to_string())?;
+    // A time unit named nowhere: read as seconds, else as milliseconds (the reader
+    // refuses a rate outside its physical range); the step decides below.
+    let scales: &[f64] = match time.unit {
+        Some("ms") => &[1e-3],
+        Some(_) => &[1.0],
+        None => &[1.0, 1e-3],
+    };
+    let read = |to_s: f64| {
+        LogReader::new(name)
+            .format(LogFormat {
+                delimiter: Some(delimiter),
+                decimal: Some(decimal),
+            })
+            .time(&time.column, to_s)
+            .displacement(&disp_col, 1.0)
+            .parse(bytes)
+            .map(|d| (to_s, d))
+            .map_err(|e| e.to_string())
+    };
+    let (to_s, data) = scales[1..].iter().fold(read(scales[0]), |got, &k| got.or_else(|_| read(k)))?;
     let raw_step = median_step(&data.time_s) / to_s;
     if time.unit.is_none() {
         (time.unit, time.unit_from) = match raw_step {

@@ -254,7 +254,14 @@ fn soft_and_stiff_inward_restraint_from_solver_logs() {
 fn accuracy_table() {
     use rocklab::peaks::Method;
     use rocklab::signal::savgol::SavGol;
-    for name in ["one-sided-demo", "two-sided-demo", "mujoco-public-one-sided", "mujoco-public-two-sided"] {
+    for name in [
+        "one-sided-demo",
+        "two-sided-demo",
+        "mujoco-public-one-sided",
+        "mujoco-public-two-sided",
+        "mujoco-holdout-one-sided",
+        "mujoco-holdout-two-sided",
+    ] {
         for (label, method) in [
             ("rocklab (default)", Method::Segments),
             ("Savitzky–Golay 11/3 + peaks", Method::SavGol(SavGol::new(11, 3).unwrap())),

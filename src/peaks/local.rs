@@ -311,6 +311,62 @@ pub fn read(t: &[f64], y: &[f64], t_peak: f64, want: f64, dt: f64, max_half: usi
     })
 }
 
+/// The per-impact choice (module docs) on a global fit: every peak the log
+/// resolves as a smooth extreme is replaced by its local reading, its row and
+/// column of the covariance by its own variance (the local reading shares no
+/// parameter with the global fit). Returns the method of each peak.
+pub(super) fn choose(
+    fit: &super::segments::SegmentFit,
+    peaks: &mut [super::Peak],
+    cov: Option<&mut Vec<Vec<f64>>>,
+    dt: f64,
+    sigma: f64,
+) -> Vec<ReadingMethod> {
+    let m = fit.model();
+    let readings: Vec<Option<LocalReading>> = (0..peaks.len())
+        .map(|k| {
+            let start = if k == 0 { m.release_time() } else { m.release_from_contact(k - 1) };
+            let end = if k + 1 < m.m() {
+                m.onset(k + 1)
+            } else {
+                fit.tw.last().copied().unwrap_or(start)
+            };
+            let t0 = peaks[k].time_s;
+            let room = (t0 - start).min(end - t0).max(0.0);
+            let max_half = (0.8 * room / dt).floor() as usize;
+            let want = if k % 2 == 0 { -1.0 } else { 1.0 };
+            read(&fit.tw, &fit.yw, t0, want, dt, max_half, sigma)
+        })
+        .collect();
+    // One method for the whole test: the ratios of the tables cancel a bias
+    // that its peaks share only if they share the reading (module docs).
+    if readings.iter().any(Option::is_none) {
+        return vec![ReadingMethod::KinkModel; peaks.len()];
+    }
+    let mut cov = cov;
+    readings
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let Some(r) = r else { return ReadingMethod::KinkModel };
+            peaks[k].time_s = r.time_s;
+            peaks[k].velocity_mm_s = r.velocity_mm_s;
+            peaks[k].velocity_u_mm_s = Some(r.u_mm_s);
+            if let Some(c) = cov.as_deref_mut() {
+                for (j, row) in c.iter_mut().enumerate() {
+                    row[k] = if j == k { r.u_mm_s * r.u_mm_s } else { 0.0 };
+                }
+                for (j, v) in c[k].iter_mut().enumerate() {
+                    if j != k {
+                        *v = 0.0;
+                    }
+                }
+            }
+            ReadingMethod::LocalExtreme
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,60 +426,4 @@ mod tests {
             .collect();
         assert!(read(&t, &yk, 0.0, -1.0, dt, 30, 0.001).is_none());
     }
-}
-
-/// The per-impact choice (module docs) on a global fit: every peak the log
-/// resolves as a smooth extreme is replaced by its local reading, its row and
-/// column of the covariance by its own variance (the local reading shares no
-/// parameter with the global fit). Returns the method of each peak.
-pub(super) fn choose(
-    fit: &super::segments::SegmentFit,
-    peaks: &mut [super::Peak],
-    cov: Option<&mut Vec<Vec<f64>>>,
-    dt: f64,
-    sigma: f64,
-) -> Vec<ReadingMethod> {
-    let m = fit.model();
-    let readings: Vec<Option<LocalReading>> = (0..peaks.len())
-        .map(|k| {
-            let start = if k == 0 { m.release_time() } else { m.release_from_contact(k - 1) };
-            let end = if k + 1 < m.m() {
-                m.onset(k + 1)
-            } else {
-                fit.tw.last().copied().unwrap_or(start)
-            };
-            let t0 = peaks[k].time_s;
-            let room = (t0 - start).min(end - t0).max(0.0);
-            let max_half = (0.8 * room / dt).floor() as usize;
-            let want = if k % 2 == 0 { -1.0 } else { 1.0 };
-            read(&fit.tw, &fit.yw, t0, want, dt, max_half, sigma)
-        })
-        .collect();
-    // One method for the whole test: the ratios of the tables cancel a bias
-    // that its peaks share only if they share the reading (module docs).
-    if readings.iter().any(Option::is_none) {
-        return vec![ReadingMethod::KinkModel; peaks.len()];
-    }
-    let mut cov = cov;
-    readings
-        .iter()
-        .enumerate()
-        .map(|(k, r)| {
-            let Some(r) = r else { return ReadingMethod::KinkModel };
-            peaks[k].time_s = r.time_s;
-            peaks[k].velocity_mm_s = r.velocity_mm_s;
-            peaks[k].velocity_u_mm_s = Some(r.u_mm_s);
-            if let Some(c) = cov.as_deref_mut() {
-                for (j, row) in c.iter_mut().enumerate() {
-                    row[k] = if j == k { r.u_mm_s * r.u_mm_s } else { 0.0 };
-                }
-                for (j, v) in c[k].iter_mut().enumerate() {
-                    if j != k {
-                        *v = 0.0;
-                    }
-                }
-            }
-            ReadingMethod::LocalExtreme
-        })
-        .collect()
 }

@@ -47,7 +47,11 @@
 //! the slope of the arc before impact k exactly at t_k (no smoothing bias); with
 //! contact phases, whose smooth joins leave the fitted zero loose by a few mm,
 //! the mean of the readings up to the fitted zero and up to the rest line, their
-//! spread a term of its uncertainty ([`model::Model::peak`]).
+//! spread a term of its uncertainty ([`model::Model::peak`]). Where every
+//! peak of a test sits in a contact phase that spans several samples, each is
+//! read instead from the samples around it, a local fit of the smooth extreme
+//! with its own uncertainty ([`local`]); [`Analysis::resolved_peaks`] says
+//! which reading each peak got.
 //!
 //! Before the fit: isolated spikes are replaced, the line through the final rest
 //! (its slope shared with the initial hold) is subtracted (the sensor's zero and a

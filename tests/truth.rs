@@ -254,7 +254,14 @@ fn soft_and_stiff_inward_restraint_from_solver_logs() {
 fn accuracy_table() {
     use rocklab::peaks::Method;
     use rocklab::signal::savgol::SavGol;
-    for name in ["one-sided-demo", "two-sided-demo", "mujoco-public-one-sided", "mujoco-public-two-sided"] {
+    for name in [
+        "one-sided-demo",
+        "two-sided-demo",
+        "mujoco-public-one-sided",
+        "mujoco-public-two-sided",
+        "mujoco-holdout-one-sided",
+        "mujoco-holdout-two-sided",
+    ] {
         for (label, method) in [
             ("rocklab (default)", Method::Segments),
             ("Savitzky–Golay 11/3 + peaks", Method::SavGol(SavGol::new(11, 3).unwrap())),
@@ -281,5 +288,110 @@ fn accuracy_table() {
             let cells: Vec<String> = worst.iter().map(|w| format!("{w:.2}")).collect();
             println!("| {name} | {label} | {} |", cells.join(" | "));
         }
+    }
+}
+
+/// Per test of a campaign: worst |error| (pp) of its table values, whether its
+/// status is ok, and |error| / u of each of its first six peaks (u the stated
+/// standard uncertainty).
+fn holdout_report(name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
+    let e_h = campaign.e_housner;
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let res = reduce_campaign(campaign, PeakOptions::default());
+    let mut out = Vec::new();
+    for t in &res.tests {
+        let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
+        let v: Vec<f64> = r.analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
+        let worst = errors_pp(&v, e_h, tt).iter().map(|e| e.1.abs()).fold(0.0, f64::max);
+        let true_v: Vec<f64> = tt["peaks"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|q| q["velocity_mm_s"].as_f64().unwrap())
+            .collect();
+        let z: Vec<f64> = r
+            .analysis
+            .resolved_peaks()
+            .iter()
+            .zip(&true_v)
+            .map(|(p, &q)| (p.velocity_mm_s - q).abs() / p.u_mm_s)
+            .collect();
+        let errs: Vec<String> = r
+            .analysis
+            .resolved_peaks()
+            .iter()
+            .zip(&true_v)
+            .map(|(p, &q)| {
+                format!(
+                    "{:+.1}%±{:.1} {:?}",
+                    100.0 * (p.velocity_mm_s / q - 1.0),
+                    100.0 * p.u_mm_s / q.abs(),
+                    p.method
+                )
+            })
+            .collect();
+        println!(
+            "{name} {}: worst {worst:.2} pp, peaks {} [{}]",
+            t.spec.id,
+            errs.join(", "),
+            r.analysis.quality.describe()
+        );
+        out.push((t.spec.id.clone(), worst, r.analysis.quality.is_ok(), z));
+    }
+    out
+}
+
+/// (tests flagged, worst value of the ok tests in pp, share of the ok tests'
+/// peaks within 2 stated u).
+fn holdout_summary(name: &str) -> (usize, f64, f64) {
+    let rep = holdout_report(name);
+    let flagged = rep.iter().filter(|r| !r.2).count();
+    let worst_ok = rep.iter().filter(|r| r.2).map(|r| r.1).fold(0.0, f64::max);
+    let z: Vec<f64> = rep.iter().filter(|r| r.2).flat_map(|r| r.3.clone()).collect();
+    let within = z.iter().filter(|&&v| v <= 2.0).count() as f64 / z.len().max(1) as f64;
+    println!(
+        "{name}: {flagged} flagged, ok tests within {worst_ok:.2} pp, {:.0} % of their peaks within 2 u",
+        100.0 * within
+    );
+    (flagged, worst_ok, within)
+}
+
+/// Issue 18: walls the estimator was not tuned on, made with MuJoCo by
+/// `tools/mujoco_campaign.py` (a slenderer wall on a stiff bedding with lossy
+/// transverse walls, one-sided, 100–1000 Hz; a squatter wall on a soft bedding,
+/// two-sided). Measured when this was written: two-sided, 2 of 5 tests flagged
+/// (H2_110_2: the residuals around impact 4; H2_70_1: its late contacts), the ok
+/// ones within 0.58 pp; one-sided, 1 of 6 flagged, the ok ones within 1.24 pp
+/// (the inward half-cycles' peaks 2–3.5 % low: the global fit's lossy-restraint
+/// arc against MuJoCo's restraint); 100 % (two-sided) and 97 % (one-sided) of the ok tests' peaks
+/// within 2 u. This test guards what holds (no ok test of the two-sided
+/// campaign beyond the issue's 1.0 pp, the coverage of u, at most one one-sided
+/// test flagged); `holdouts_meet_the_issue` is the issue's full criterion,
+/// not met yet.
+#[test]
+fn mujoco_holdouts_reduced_or_flagged() {
+    let (_, worst2, within2) = holdout_summary("mujoco-holdout-two-sided");
+    assert!(worst2 <= 1.0, "two-sided: an ok test {worst2:.2} pp off");
+    assert!(within2 >= 0.9, "two-sided: {within2:.2} of the peaks within 2 u");
+    let (flagged1, _, within1) = holdout_summary("mujoco-holdout-one-sided");
+    assert!(flagged1 <= 1, "one-sided: {flagged1} tests flagged");
+    assert!(within1 >= 0.9, "one-sided: {within1:.2} of the peaks within 2 u");
+}
+
+/// The issue's criterion on both hold-out campaigns: at most one test flagged
+/// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
+/// within 2 u. Fails today (see `mujoco_holdouts_reduced_or_flagged`).
+#[test]
+#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.24 pp, two-sided 2 flagged"]
+fn holdouts_meet_the_issue() {
+    for name in ["mujoco-holdout-one-sided", "mujoco-holdout-two-sided"] {
+        let (flagged, worst, within) = holdout_summary(name);
+        assert!(
+            flagged <= 1 && worst <= 1.0 && within >= 0.9,
+            "{name}: {flagged} flagged, {worst:.2} pp, {within:.2} within 2 u"
+        );
     }
 }

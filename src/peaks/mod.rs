@@ -47,7 +47,11 @@
 //! the slope of the arc before impact k exactly at t_k (no smoothing bias); with
 //! contact phases, whose smooth joins leave the fitted zero loose by a few mm,
 //! the mean of the readings up to the fitted zero and up to the rest line, their
-//! spread a term of its uncertainty ([`model::Model::peak`]).
+//! spread a term of its uncertainty ([`model::Model::peak`]). Where every
+//! peak of a test sits in a contact phase that spans several samples, each is
+//! read instead from the samples around it, a local fit of the smooth extreme
+//! with its own uncertainty ([`local`]); [`Analysis::resolved_peaks`] says
+//! which reading each peak got.
 //!
 //! Before the fit: isolated spikes are replaced, the line through the final rest
 //! (its slope shared with the initial hold) is subtracted (the sensor's zero and a
@@ -72,6 +76,7 @@
 
 pub mod checks;
 mod crossings;
+pub mod local;
 pub mod model;
 mod picking;
 mod prepare;
@@ -226,6 +231,43 @@ pub struct Analysis {
     /// The second estimate of each peak: a local fit of the end of its arc
     /// (velocity, standard uncertainty), where the arc has enough samples.
     pub local_peaks: Vec<Option<(f64, f64)>>,
+    /// How each peak was read (default estimator; empty for Savitzky–Golay).
+    pub methods: Vec<ReadingMethod>,
+}
+
+pub use local::ReadingMethod;
+
+/// One velocity peak with its standard uncertainty and how it was read
+/// ([`Analysis::resolved_peaks`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ResolvedPeak {
+    pub k: usize,
+    pub time_s: f64,
+    pub velocity_mm_s: f64,
+    pub u_mm_s: f64,
+    pub method: ReadingMethod,
+}
+
+impl Analysis {
+    /// Every peak the analysis read, with its standard uncertainty (the
+    /// diagonal of [`Analysis::peak_covariance`]) and its reading method;
+    /// empty for the Savitzky–Golay estimator, which states no uncertainty.
+    pub fn resolved_peaks(&self) -> Vec<ResolvedPeak> {
+        self.peaks
+            .iter()
+            .zip(&self.methods)
+            .enumerate()
+            .filter_map(|(k, (p, &method))| {
+                Some(ResolvedPeak {
+                    k,
+                    time_s: p.time_s,
+                    velocity_mm_s: p.velocity_mm_s,
+                    u_mm_s: p.velocity_u_mm_s?,
+                    method,
+                })
+            })
+            .collect()
+    }
 }
 
 /// What the plausibility checks say of an analysis: `Ok`, or `Suspect` with the
@@ -341,6 +383,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         contact_phases: false,
         gamma_fit: None,
         local_peaks: Vec::new(),
+        methods: Vec::new(),
     }
 }
 
@@ -375,7 +418,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         uncertainty::add_zero_spread(&mut c, &spread);
         c
     });
-    let peaks: Vec<Peak> = impacts
+    let mut cov = cov;
+    let mut peaks: Vec<Peak> = impacts
         .iter()
         .take(n_peaks)
         .enumerate()
@@ -385,8 +429,10 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
             velocity_u_mm_s: cov.as_ref().map(|c| c[k][k].max(0.0).sqrt()),
         })
         .collect();
+    // Per impact: the local reading where the log resolves a smooth extreme.
+    let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, p.dt, p.sigma);
+    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,
@@ -404,5 +450,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         contact_phases: fit.contacts,
         gamma_fit: fit.model().gamma(),
         local_peaks: local,
+        methods,
     })
 }

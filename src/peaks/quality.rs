@@ -2,7 +2,7 @@
 //! analysis ([`super::checks`]).
 
 use super::segments::SegmentFit;
-use super::{checks, Peak, Quality};
+use super::{checks, Peak, Quality, ReadingMethod};
 
 /// The second estimate of each peak: the end of free arc k re-fitted from its own
 /// samples (the later half of the arc, at least 4 samples) by [`checks::local_slope`].
@@ -27,16 +27,33 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 /// Run every check of [`checks`] on a fit (`spread[k]`: the difference between
 /// peak k's two readings of where its half-cycle ends,
 /// [`super::model::Model::peak_spread`]).
-pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f64, f64)>], spread: &[f64], dt: f64, sigma: f64) -> Quality {
+///
+/// A peak read locally (`methods[k]`, [`super::local`]) does not depend on the
+/// global fit's contact phase at impact k nor on where its zero lies: the checks
+/// of that contact (its length, its overshoot, its zero readings, the residuals
+/// around it, the re-fit of the arc's end) are not run for it.
+pub(super) fn plausibility(
+    fit: &SegmentFit,
+    peaks: &[Peak],
+    local: &[Option<(f64, f64)>],
+    spread: &[f64],
+    methods: &[ReadingMethod],
+    dt: f64,
+    sigma: f64,
+) -> Quality {
+    let is_local = |k: usize| methods.get(k) == Some(&ReadingMethod::LocalExtreme);
+    let local: Vec<Option<(f64, f64)>> = local.iter().enumerate().map(|(k, l)| if is_local(k) { None } else { *l }).collect();
+    let spread: Vec<f64> = spread.iter().enumerate().map(|(k, &d)| if is_local(k) { 0.0 } else { d }).collect();
     let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
     let u: Vec<f64> = peaks.iter().map(|p| p.velocity_u_mm_s.unwrap_or(0.0)).collect();
     let m = fit.model();
     // Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
     let spring: Vec<bool> = (0..m.m()).map(|s| m.one_sided && s % 2 == 1).collect();
+    let overshoot_skip: Vec<bool> = (0..m.m()).map(|s| spring[s] || is_local(s)).collect();
     // The local re-fit estimates the free arc's slope at the onset of contact.
     let v_onset: Vec<f64> = (0..v.len()).map(|k| m.speeds(k).0).collect();
     let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
-    let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
+    let onsets: Vec<f64> = (0..m.m()).map(|k| if is_local(k) { f64::NAN } else { m.onset(k) }).collect();
     let resid = fit.residuals();
     // Impacts 0..n−2: the ones between the peaks the tables use.
     let after: Vec<Option<f64>> = (0..v.len().saturating_sub(1)).map(|k| m.speeds(k).1).collect();
@@ -47,17 +64,22 @@ pub(super) fn plausibility(fit: &SegmentFit, peaks: &[Peak], local: &[Option<(f6
         checks::impact_gains_speed(&v, &after, &u),
         checks::misfit(&resid, sigma),
         checks::structured_near_impacts(&fit.tw, &resid, &onsets, dt, sigma),
-        checks::disagreement(&v_onset, &u, local),
+        checks::disagreement(&v_onset, &u, &local),
         m.contact_windows().and_then(|windows| {
+            let windows: Vec<(f64, f64)> = windows
+                .iter()
+                .enumerate()
+                .map(|(k, &w)| if is_local(k) { (0.0, 0.0) } else { w })
+                .collect();
             let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
             checks::contact_too_long(&windows, &arcs, &spring)
         }),
         if fit.contacts {
-            checks::contact_overshoot(&v, &v_onset, &u, &spring)
+            checks::contact_overshoot(&v, &v_onset, &u, &overshoot_skip)
         } else {
             None
         },
-        checks::zero_readings_disagree(&v, spread),
+        checks::zero_readings_disagree(&v, &spread),
     ]
     .into_iter()
     .flatten()

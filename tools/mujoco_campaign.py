@@ -1,0 +1,255 @@
+#!/usr/bin/env python3
+"""Make a free-rocking campaign with the MuJoCo physics engine (compliant contacts).
+
+Not run by CI: it makes hold-out campaigns of walls the estimator has not been tuned on
+(issue 18): a rigid box on a compliant bedding (MuJoCo soft contacts, so impacts last
+several ms and begin before theta = 0) and, one-sided, two fixed transverse-wall blocks
+with a damped compliant contact (a lossy inward restraint). Same engine set-up as the
+`mujoco-public-*` campaigns (`sim` blocks of their truth.json), other walls and rates.
+
+    pip install mujoco numpy
+    python3 tools/mujoco_campaign.py --preset holdout-one-sided --out fixtures/campaigns/mujoco-holdout-one-sided
+    python3 tools/mujoco_campaign.py --preset holdout-two-sided --out fixtures/campaigns/mujoco-holdout-two-sided
+
+Truth: peaks[k] is the extreme of the sensor point's horizontal velocity within
+half-cycle k (between zero crossings k-1 and k of theta), from the engine's state at
+every 0.1 ms step; the table values are computed from those peaks (paper Eqs. 3-6).
+The sensor reads the horizontal displacement of a point of the outward face at height L
+(L sin theta plus the bedding's own small motion), plus Gaussian noise, a linear drift
+and 0.01 mm quantisation, sampled at fs with a random phase.
+"""
+import argparse
+import json
+import math
+import os
+
+import mujoco
+import numpy as np
+
+PRESETS = {
+    # A slenderer wall than the public campaigns, stiff bedding, lossy transverse walls.
+    "holdout-one-sided": dict(
+        rocking="one-sided", H=2.60, b=0.36, w=1.60, density=1900.0, L=2.50,
+        bed_tc=(0.002, 0.005), bed_solimp=[0.05, 0.8, 0.0005, 0.5, 2.0],
+        K_in=(1000.0, 3000.0), zeta_in=(0.03, 0.08),
+        tests=[("H1_160_1", 160, 200), ("H1_160_2", 160, 500), ("H1_140_1", 140, 1000),
+               ("H1_140_2", 140, 200), ("H1_130_1", 130, 500), ("H1_150_1", 150, 100)],
+        seed=18_1,
+    ),
+    # A squatter wall on a soft bedding: long contacts that begin well before theta = 0.
+    "holdout-two-sided": dict(
+        rocking="two-sided", H=2.20, b=0.40, w=1.20, density=2000.0, L=2.10,
+        bed_tc=(0.010, 0.025), bed_solimp=[0.1, 0.4, 0.001, 0.5, 2.0],
+        tests=[("H2_110_1", 110, 200), ("H2_110_2", 110, 1000), ("H2_90_1", 90, 500),
+               ("H2_80_1", 80, 100), ("H2_70_1", 70, 200)],
+        seed=18_2,
+    ),
+}
+
+DT = 1e-4
+
+
+def build(p, rng):
+    H, b, w = p["H"], p["b"], p["w"]
+    tc = rng.uniform(*p["bed_tc"])
+    mu = rng.uniform(0.8, 1.0)
+    bed = " ".join(f"{v:g}" for v in p["bed_solimp"])
+    obst = ""
+    extra = {}
+    if p["rocking"] == "one-sided":
+        K = rng.uniform(*p["K_in"])
+        zeta = rng.uniform(*p["zeta_in"])
+        # Direct stiffness and damping of the constraint (MuJoCo's negative solref):
+        # a_ref = -K r - 2 zeta sqrt(K) r', a linear spring-dashpot in the contact's
+        # acceleration space (the public campaigns' (timeconst, dampratio) form made the
+        # restraint's stiffness depend on zeta here).
+        tco, dmp = -K, -2.0 * zeta * math.sqrt(K)
+        extra = dict(obst_K_target_per_s2=K, obst_zeta=zeta, obst_solref=[tco, dmp])
+        for s in (-1, 1):
+            y = s * (w / 2 - 0.125)
+            obst += (
+                f'<geom type="box" size="0.5 0.125 {0.35 * H:g}" pos="{-b / 2 - 0.5:g} {y:g} {0.65 * H:g}" '
+                f'condim="1" solref="{tco:g} {dmp:g}" solimp="0.9 0.95 0.001 0.5 2" contype="2" conaffinity="2" rgba="0.5 0.5 0.5 1"/>'
+            )
+    xml = f"""
+<mujoco>
+  <option timestep="{DT}" integrator="implicitfast" cone="elliptic" impratio="10" solver="Newton" iterations="100" tolerance="1e-10"/>
+  <worldbody>
+    <geom name="floor" type="plane" size="20 20 0.1" condim="3" friction="{mu:g} 0.005 0.0001"
+          solref="{tc:g} 1" solimp="{bed}" contype="1" conaffinity="1"/>
+    {obst}
+    <body name="wall" pos="0 0 {H / 2:g}">
+      <freejoint/>
+      <geom type="box" size="{b / 2:g} {w / 2:g} {H / 2:g}" density="{p['density']:g}" contype="3" conaffinity="3"/>
+      <site name="sensor" pos="{b / 2:g} 0 {p['L'] - H / 2:g}"/>
+      <site name="top" pos="{b / 2:g} 0 {H / 2:g}"/>
+    </body>
+  </worldbody>
+  <equality>
+    <connect name="hold" body1="wall" anchor="{b / 2:g} 0 {H / 2:g}" active="true"/>
+  </equality>
+</mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    return m, dict(floor_solref=[tc, 1.0], friction_mu=mu, **extra)
+
+
+def set_tilt(m, d, p, theta):
+    """Pose of the wall rotated by theta about its outward toe (theta > 0 outward)."""
+    H, b = p["H"], p["b"]
+    c, s = math.cos(theta), math.sin(theta)
+    # Rotation about +y by theta moves +z toward +x.
+    toe = np.array([b / 2, 0.0, 0.0])
+    centre0 = np.array([0.0, 0.0, H / 2])
+    r = centre0 - toe
+    centre = toe + np.array([c * r[0] + s * r[2], 0.0, -s * r[0] + c * r[2]])
+    d.qpos[:3] = centre
+    d.qpos[3:7] = [math.cos(theta / 2), 0.0, math.sin(theta / 2), 0.0]
+    d.qvel[:] = 0.0
+    mujoco.mj_forward(m, d)
+    # The hold: anchor the top's outward corner where it is now.
+    m.eq_data[0, 3:6] = d.site_xpos[1]
+
+
+def theta_of(d):
+    R = d.xmat[1].reshape(3, 3)
+    return math.atan2(R[0, 2], R[2, 2])
+
+
+def simulate(p, x0_mm, rng):
+    m, sim = build(p, rng)
+    d = mujoco.MjData(m)
+    theta0 = math.asin(x0_mm / 1000.0 / p["L"])
+    set_tilt(m, d, p, theta0)
+    settle = 1.0
+    t_rel = settle
+    rec = []
+    n_steps = int((settle + 30.0) / DT)
+    sensor_id = 0
+    released = False
+    still = 0
+    for i in range(n_steps):
+        t = i * DT
+        if not released and t >= t_rel:
+            d.eq_active[0] = 0
+            released = True
+        mujoco.mj_step(m, d)
+        th = theta_of(d)
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, sensor_id, vel, 0)
+        R = d.xmat[1].reshape(3, 3)
+        z_toes = [d.xpos[1][2] + R[2, 0] * sx * p["b"] / 2 - R[2, 2] * p["H"] / 2 for sx in (1, -1)]
+        rec.append((d.time, d.site_xpos[sensor_id][0], vel[3], th, max(z_toes)))
+        if released and abs(th) < 2e-5 and abs(d.qvel[4]) < 2e-4:
+            still += 1
+            if still > 20000:
+                break
+        else:
+            still = 0
+    a = np.array(rec)
+    return a, theta0, t_rel, sim
+
+
+def truth_peaks(a, t_rel, rocking):
+    t, v, th = a[:, 0], a[:, 2], a[:, 3]  # noqa: E741
+    i0 = np.searchsorted(t, t_rel)
+    cross = []
+    for i in range(i0 + 1, len(t)):
+        if th[i - 1] * th[i] < 0 or (th[i] == 0 and th[i - 1] != 0):
+            cross.append(i)
+    peaks = []
+    start = i0
+    for k, ic in enumerate(cross[:12]):
+        seg = slice(start, ic + 1)
+        want = -1.0 if k % 2 == 0 else 1.0
+        j = start + int(np.argmax(want * v[seg]))
+        lifted = float(np.mean(a[seg, 4] > 0.0))
+        peaks.append(dict(k=k, i=j, velocity_mm_s=1000.0 * v[j], lift_fraction=lifted))
+        start = ic
+    return peaks, [t[i] for i in cross[:12]]
+
+
+def tables(v, e_h):
+    loc = [abs(v[k + 1] / v[k]) for k in range(5)]
+    ss = lambda k: math.sqrt(abs(v[k + 2] / v[k]))
+    e = sum(loc) / 5
+    e_minus = 0.5 * (ss(0) + ss(2))
+    e_plus = 0.5 * (ss(1) + ss(3))
+    return dict(e=e, e_plus=e_plus, e_minus=e_minus, r=e / e_h, r_plus=e_plus / e_h,
+                r_minus=e_minus / e_h, r1=loc[0] / e_h, r1_plus=ss(1) / e_h, r1_minus=ss(0) / e_h,
+                r2=0.5 * (loc[0] + loc[1]) / e_h)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--preset", required=True, choices=sorted(PRESETS))
+    ap.add_argument("--out", required=True)
+    args = ap.parse_args()
+    p = PRESETS[args.preset]
+    rng = np.random.default_rng(p["seed"])
+    os.makedirs(args.out, exist_ok=True)
+    name = os.path.basename(os.path.normpath(args.out))
+    H, b = p["H"], p["b"]
+    alpha = math.atan(b / H)
+    e_h = 1 - 1.5 * math.sin(alpha) ** 2
+    mass = p["density"] * H * b * p["w"]
+    toml = [f"# Hold-out campaign made with MuJoCo {mujoco.__version__} by tools/mujoco_campaign.py --preset {args.preset}",
+            "# (rigid wall, compliant finite-duration contacts); truth in truth.json.", "",
+            "[campaign]", f'name = "{name}"', f'rocking = "{p["rocking"]}"', "", "[wall]",
+            f"height_m = {H:.2f}", f"thickness_m = {b:.2f}", f"width_m = {p['w']:.2f}",
+            f"weight_kN = {mass * 9.81 / 1000:.1f}", "hinge_height_m = 0.00", "", "[channels]",
+            'time = { column = "time_s", unit = "s" }',
+            f'displacement = {{ column = "disp_mm", unit = "mm", height_m = {p["L"]:.2f} }}',
+            "outward_sign = 1", "", "[format]", 'delimiter = ","', 'decimal = "."']
+    tests = []
+    for tid, x0, fs in p["tests"]:
+        a, theta0, t_rel, sim = simulate(p, x0, rng)
+        peaks, cross = truth_peaks(a, t_rel, p["rocking"])
+        # As the public campaigns: a test is only made if its wall still rocks (one
+        # edge off the bedding for most of each half-cycle) through the six peaks the
+        # tables use; below that the "half-cycles" are the bedding's own wobble.
+        lift = [q["lift_fraction"] for q in peaks]
+        if len(peaks) < 6 or min(lift[:6]) < 0.5:
+            raise SystemExit(f"{tid}: the wall stops rocking before peak 6 (lift fractions {lift})")
+        # Logger: a random phase, from 1 s before the release to 3 s after the motion ends.
+        sigma = rng.uniform(0.01, 0.04)
+        drift = rng.uniform(-0.2, 0.2)
+        t_start = t_rel - 1.0 + rng.uniform(0, 1 / fs)
+        t_end = min(a[-1, 0], cross[-1] + 3.0)
+        ts = np.arange(t_start, t_end, 1 / fs)
+        x_rest = a[-1, 1]
+        xs = np.interp(ts, a[:, 0], a[:, 1]) - x_rest
+        xs = 1000.0 * xs
+        xs += rng.normal(0, sigma, len(ts)) + drift * (ts - ts[0]) / (ts[-1] - ts[0])
+        xs = np.round(xs / 0.01) * 0.01
+        t_file = ts - ts[0]
+        with open(os.path.join(args.out, f"{tid}.csv"), "w") as f:
+            f.write(f"# campaign: {name}\n# test: {tid}\n# sampling_rate_Hz: {fs}\n")
+            f.write(f"# channels: time_s [s]; disp_mm [mm] LVDT at {p['L']:.2f} m, positive = outward\n")
+            f.write("time_s,disp_mm\n")
+            for ti, xi in zip(t_file, xs):
+                f.write(f"{ti:.6f},{xi:.2f}\n")
+        pk = [dict(k=q["k"], time_s=a[q["i"], 0] - ts[0], velocity_mm_s=q["velocity_mm_s"]) for q in peaks]
+        v = [q["velocity_mm_s"] for q in pk]
+        tab = tables(v, e_h)
+        sim.update(engine=f"MuJoCo {mujoco.__version__}", timestep_s=DT, fs_Hz=fs, sigma_mm=sigma, drift_mm=drift,
+                   quant_mm=0.01, x0_mm_nominal=x0, theta0_rad=theta0, t_release_s=t_rel - ts[0],
+                   zero_crossings_s=[c - ts[0] for c in cross], rocking_mass_kg=mass,
+                   lift_fraction_per_half_cycle=lift)
+        tests.append(dict(id=tid, file=f"{tid}.csv", exclude_from_mean=False, sim=sim, peaks=pk,
+                          **{k: tab[k] for k in ("r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2")},
+                          e=tab["e"], e_plus=tab["e_plus"], e_minus=tab["e_minus"]))
+        toml += ["", "[[test]]", f'id = "{tid}"', f'file = "{tid}.csv"', f"imposed_displacement_mm = {x0}",
+                 "exclude_from_mean = false"]
+        print(tid, fs, " ".join(f"{x:.1f}" for x in v[:8]), {k: round(tab[k], 4) for k in ("r", "r1")})
+    with open(os.path.join(args.out, "campaign.toml"), "w") as f:
+        f.write("\n".join(toml) + "\n")
+    truth = dict(campaign=name, rocking=p["rocking"], generator=f"MuJoCo {mujoco.__version__}, tools/mujoco_campaign.py --preset {args.preset}",
+                 conventions="as mujoco-public-*: peaks[k] = extreme of the sensor's horizontal velocity within half-cycle k (mm/s, outward positive); r.. divided by e_H",
+                 alpha_rad=alpha, e_housner=e_h, e_H=e_h, wall=dict(height_m=H, thickness_m=b, width_m=p["w"], sensor_height_m=p["L"]),
+                 tests=tests)
+    with open(os.path.join(args.out, "truth.json"), "w") as f:
+        json.dump(truth, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

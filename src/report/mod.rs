@@ -10,6 +10,7 @@ pub mod docs;
 pub mod facade;
 pub mod finite;
 pub mod html;
+pub mod law;
 pub mod plots;
 pub mod quality;
 pub mod response;

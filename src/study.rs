@@ -47,6 +47,7 @@ pub fn model(block: &BlockSpec, spec: &RunSpec) -> RockingModel {
         ties: block.ties.clone(),
         e_in: spec.e_in,
         e_out: spec.e_out,
+        law: None,
         overturn_limit: spec.overturn_limit,
         linearized: false,
     }

@@ -35,6 +35,7 @@ fn rectangular_pulse_probability_matches_the_draws_above_housner_threshold() {
         ties: Vec::new(),
         e_in: 0.9,
         e_out: 0.9,
+        law: None,
         overturn_limit: alpha,
         linearized: true,
     };

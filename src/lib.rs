@@ -43,6 +43,7 @@ pub mod peaks;
 pub mod reduction;
 pub mod report;
 pub mod restitution;
+pub mod restitution_law;
 pub mod signal;
 pub mod solver;
 pub mod stats;

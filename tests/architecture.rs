@@ -22,6 +22,7 @@ const CORE: &[&str] = &[
     "src/peaks",
     "src/reduction.rs",
     "src/restitution.rs",
+    "src/restitution_law.rs",
     "src/signal",
     "src/solver",
     "src/stats.rs",

@@ -597,3 +597,48 @@ fn facade_ensemble_errors() {
     let o = facade(&study, &dir.path().join("o"), &[]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("sd_e = -0.1"));
 }
+
+/// Issue 20: a coefficient set may be a restitution law (`law = FILE`, a
+/// summary.json's `restitution_law` or the law alone): the study runs it and says
+/// so; its errors name the set, the key, or the law file with line and column.
+#[test]
+fn facade_law_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let law = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/law.json");
+    let law_text = std::fs::read_to_string(&law).unwrap();
+    // A summary-shaped file: the law under "restitution_law", beside other keys.
+    std::fs::write(
+        dir.path().join("summary.json"),
+        format!("{{\"campaign\": \"x\", \"restitution_law\": {law_text}}}"),
+    )
+    .unwrap();
+    let with_set = |set: &str| SMALL_STUDY.to_string() + "\n[[coefficients]]\nname = \"law\"\n" + set + "\n";
+    let study = write_study(dir.path(), &with_set(&format!("law = \"{}\"", law.display())));
+    let out = dir.path().join("out");
+    let o = facade(&study, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = s["runs"].as_array().unwrap();
+    assert!(runs.iter().any(|r| r["coefficients"] == "law"));
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(md.contains("the law's e at a = 1"), "{md}");
+    let study = write_study(dir.path(), &with_set("law = \"summary.json\"\ne_h = 0.98\nspread = \"none\""));
+    let o = facade(&study, &dir.path().join("o2"), &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::write(dir.path().join("bad.json"), "{\n  \"form\": \"speed-loss\",\n  \"parameters\": 3\n}\n").unwrap();
+    std::fs::write(dir.path().join("none.json"), "{\"campaign\": \"x\"}").unwrap();
+    for (set, expect) in [
+        ("law = \"summary.json\"\ne_in = 0.5", "law = FILE takes no e"),
+        ("law = \"summary.json\"\nspread = \"tests\"", "spread = \"tests\": a law set takes"),
+        ("law = \"summary.json\"\ne_h = 1.5", "e_h = 1.5"),
+        ("e = 0.9\ne_h = 0.98", "e_h is for a set with a law"),
+        ("law = \"missing.json\"", "not found"),
+        ("law = \"bad.json\"", "bad.json:3"),
+        ("law = \"none.json\"", "no restitution_law"),
+    ] {
+        let study = write_study(dir.path(), &with_set(set));
+        let o = facade(&study, &dir.path().join("o3"), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
+    }
+}

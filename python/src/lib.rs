@@ -308,6 +308,7 @@ fn simulate<'py>(
         let spec = RunSpec {
             e_in,
             e_out,
+            law: None,
             scale,
             polarity: polarity as f64,
             overturn_limit: overturn_limit.or(d.overturn_limit_rad).unwrap_or(block.block.alpha),

@@ -17,6 +17,6 @@ pub mod model;
 pub mod run;
 
 pub use block::{Block, BlockSpec};
-pub use impact::{ConstantLaw, ImpactLaw, Restitution, RestitutionCurve};
+pub use impact::{ImpactLaw, Restitution};
 pub use model::{Ground, Restraint, RockingModel, TieRod};
 pub use run::{simulate, simulate_at, Event, Settings, Simulation, Stop};

@@ -153,7 +153,8 @@ impl RockingModel {
     }
 
     /// The coefficient of an impact entering `entering` that ends a half-cycle of
-    /// apex |θ| = `apex` (rad): the law's r(side, apex/α)·e_H, else e_in or e_out.
+    /// apex |θ| = `apex` (rad): the law's min(1, r(side, apex/α)·e_H), else e_in
+    /// or e_out.
     #[inline]
     pub fn coefficient(&self, entering: Side, apex: f64) -> f64 {
         match (&self.law, entering) {

@@ -1,5 +1,8 @@
 //! `rocklab demo`: reduce and calibrate the fixture campaigns and run the façade
-//! study, into `reports/demo/`.
+//! study, into `reports/demo/`. The façade study gets, beside its constant
+//! sets, the restitution laws of the one-sided campaigns (reduce → law in
+//! summary.json → façade): the demo's own and the engine-made one with compliant
+//! contacts (`mujoco-public-one-sided`), whose coefficient falls with amplitude.
 
 use std::process::ExitCode;
 
@@ -29,6 +32,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let cal = rocklab::ingest::calibration::read(&cal_path)?.calibration;
     let set = rocklab::facade::calibration_set("campaign", &cal_path.display().to_string(), &cal, "tests").map_err(|e| anyhow::anyhow!(e))?;
     study.sets.push(set);
+    ok &= reduce_for_law(&args, "mujoco-public-one-sided")?;
+    for (campaign, name) in [("one-sided-demo", "campaign law"), ("mujoco-public-one-sided", "mujoco law")] {
+        if let Some(set) = law_set(&args, &study, campaign, name)? {
+            study.sets.push(set);
+        }
+    }
     let scales = rocklab::facade::parse_scales(&args.scales)?;
     say(&format!(
         "façade study: {} ({} samples per record × polarity × set, seed {}; fragility from {} scales × {} samples)",
@@ -40,4 +49,43 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     ));
     super::facade::run_and_write(&study, Some(&scales), &args.out.join("facade"))?;
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Reduce a campaign only for its law: its reduce outputs into `out/NAME`.
+fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
+    let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
+    let campaign = Campaign::load(&manifest)?;
+    let sources = super::load::campaign_sources(&campaign);
+    let res = reduce_and_print(campaign, PeakOptions::default());
+    let files = rocklab::report::reduce_files(&res, &sources, true, &rocklab::report::Extras::default())?;
+    rocklab::report::write_files(&args.out.join(name), &files)?;
+    say("");
+    let ok = res.failed().next().is_none();
+    Ok(ok)
+}
+
+/// The law set `name` from the summary.json the demo wrote for `campaign` (its
+/// parameters drawn from their covariance, e_H by Eq. 2 with the façade's α);
+/// None, said on the terminal, when the summary holds no law.
+fn law_set(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Option<rocklab::facade::CoefficientSet>> {
+    let path = args.out.join(campaign).join("summary.json");
+    let text = std::fs::read_to_string(&path)?;
+    let doc: serde_json::Value = serde_json::from_str(&text)?;
+    if doc.get("restitution_law").is_none() {
+        say(&format!(
+            "{}: no restitution_law, so the façade study has no \"{name}\" set",
+            path.display()
+        ));
+        return Ok(None);
+    }
+    let law = rocklab::ingest::law::read(&path)?;
+    let source = format!("law {} ({})", path.display(), law.form.as_str());
+    Ok(Some(rocklab::facade::CoefficientSet::law(
+        name,
+        law,
+        None,
+        study.block.block.alpha,
+        true,
+        source,
+    )))
 }

@@ -248,7 +248,8 @@ fn format_invariance() {
 /// Regression for issue #2: `demo` writes tables and plots for both campaigns.
 /// Issue 10: and the façade's P(overturn) table for Housner, the paper's pair and
 /// this campaign's calibration, with the fragility plot (small ensembles: debug
-/// build).
+/// build). Issue 20: and a law set for each one-sided campaign whose summary.json
+/// holds a restitution law (the demo's own and mujoco-public-one-sided).
 #[test]
 fn demo_writes_tables_and_plots() {
     let dir = tempfile::tempdir().unwrap();
@@ -267,8 +268,15 @@ fn demo_writes_tables_and_plots() {
     let f = dir.path().join("facade");
     let s: Value = serde_json::from_str(&std::fs::read_to_string(f.join("summary.json")).unwrap()).unwrap();
     let rows = s["ensemble"]["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 3 * 2 * 3, "records × polarities × sets");
-    for set in ["housner", "calibrated", "campaign"] {
+    let mut sets = vec!["housner", "calibrated", "campaign"];
+    for (c, name) in [("one-sided-demo", "campaign law"), ("mujoco-public-one-sided", "mujoco law")] {
+        let summary: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join(c).join("summary.json")).unwrap()).unwrap();
+        if summary.get("restitution_law").is_some() {
+            sets.push(name);
+        }
+    }
+    assert_eq!(rows.len(), 3 * 2 * sets.len(), "records × polarities × sets");
+    for &set in &sets {
         assert!(rows.iter().any(|r| r["coefficients"] == set), "{set}");
         assert!(stdout.contains(&format!("| {set} | **")), "{set} row in {stdout}");
     }
@@ -278,7 +286,7 @@ fn demo_writes_tables_and_plots() {
         assert!(ci[0].as_f64().unwrap() <= p && p <= ci[1].as_f64().unwrap());
     }
     let fits = s["fragility"]["sets"].as_array().unwrap();
-    assert_eq!(fits.len(), 3);
+    assert_eq!(fits.len(), sets.len());
     for f in fits {
         assert!(f["fit"].get("median").is_some() || f["fit"].get("error").is_some(), "{f}");
     }

@@ -33,7 +33,7 @@
 //! and the fitted c is then near zero (a constant), which the form contains.
 //!
 //! A constant is the nested case c = 0 (form `"constant"`, [`RestitutionLaw::constant`]);
-//! the fit (`law_fit`) says whether the data reject it. A two-sided campaign
+//! the fit ([`crate::law_fit`]) says whether the data reject it. A two-sided campaign
 //! fits one law for both sides (`shared`: in and out are equal and drawn together).
 //!
 //! # Range

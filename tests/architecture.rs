@@ -17,6 +17,8 @@ const CORE: &[&str] = &[
     "src/facade.rs",
     "src/fit.rs",
     "src/fragility.rs",
+    "src/impacts.rs",
+    "src/law_fit.rs",
     "src/outcomes.rs",
     "src/ground_motion",
     "src/peaks",

@@ -11,6 +11,7 @@ use crate::campaign_means::{campaign_means, CampaignMeans, Row};
 use crate::error::InputError;
 use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::LogReader;
+use crate::law_fit::{fit_law, LawFit, LawFitError, TestImpacts};
 use crate::peaks::{ContactModel, Method, PeakOptions, Physics};
 pub use crate::reduction::{LogData, ReduceError, Reduced};
 
@@ -68,6 +69,9 @@ pub struct CampaignResult {
     pub options: PeakOptions,
     pub tests: Vec<TestOutcome>,
     pub means: CampaignMeans,
+    /// The campaign's restitution law ([`crate::law_fit`]) over the impacts of the
+    /// tests in the means (status ok, not excluded), or why there is none.
+    pub law: Result<LawFit, LawFitError>,
 }
 
 impl CampaignResult {
@@ -127,10 +131,16 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 /// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
 pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
     let warnings = log.warnings.clone();
-    let result = crate::reduction::reduce_log(log, &physics(campaign, spec), campaign.e_housner, options).map_err(|source| TestError::Reduce {
-        file: spec.file.clone(),
-        source,
-    });
+    let phys = physics(campaign, spec);
+    let result = crate::reduction::reduce_log(log, &phys, campaign.e_housner, options)
+        .map(|mut r| {
+            crate::reduction::resolve_impacts(&mut r, &phys, campaign.e_housner, campaign.alpha_rad, options);
+            r
+        })
+        .map_err(|source| TestError::Reduce {
+            file: spec.file.clone(),
+            source,
+        });
     TestOutcome {
         spec: spec.clone(),
         result,
@@ -171,12 +181,28 @@ pub fn campaign_result(campaign: Campaign, options: PeakOptions, tests: Vec<Test
         })
         .collect();
     let means = campaign_means(&rows);
+    let law = campaign_law(&campaign, &tests);
     CampaignResult {
         campaign,
         options,
         tests,
         means,
+        law,
     }
+}
+
+/// The law of the tests the means use (status ok, not excluded from the means).
+fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, LawFitError> {
+    let used: Vec<TestImpacts> = tests
+        .iter()
+        .filter(|t| !t.spec.exclude_from_mean)
+        .filter_map(|t| t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok()).map(|r| (t, r)))
+        .map(|(t, r)| TestImpacts {
+            id: &t.spec.id,
+            table: &r.impacts,
+        })
+        .collect();
+    fit_law(campaign.rocking, &used)
 }
 
 /// Where most of the campaign's tests show finite-duration contacts

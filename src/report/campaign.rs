@@ -54,7 +54,9 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
         motion.add_to(&mut files, &format!("plots/{id}_motion"));
         ratios.add_to(&mut files, &format!("plots/{id}_ratios"));
     }
-    let page = html::reduce_page(res, &tabs, &figs, &extra.html_sections, sources);
+    let mut sections = vec![super::law::law_files(res, with_plots, &mut files)?];
+    sections.extend(extra.html_sections.iter().cloned());
+    let page = html::reduce_page(res, &tabs, &figs, &sections, sources);
     files.add("report.html", page);
     Ok(files)
 }

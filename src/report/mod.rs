@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod docs;
 pub mod facade;
 pub mod html;
+pub mod law;
 pub mod plots;
 pub mod response;
 pub mod summary;

@@ -251,3 +251,41 @@ pub const RED: RGBColor = RGBColor(214, 39, 40);
 pub const BLUE: RGBColor = RGBColor(31, 119, 180);
 pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
 pub const GREEN: RGBColor = RGBColor(44, 160, 44);
+
+/// Colours of the tests in a plot of many (cycled).
+pub const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, ORANGE, RGBColor(148, 103, 189), RGBColor(140, 86, 75)];
+
+/// One panel of the restitution-law plot (issue 20): r of every impact against
+/// log₁₀ of its amplitude |θ|/α, one marker colour per test; the law with its ±1 u
+/// band; the constant for comparison. `tests`: (id, [(a, r)]); `law`: [(a, r, u)].
+pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, f64, f64)], constant: f64) -> Panel {
+    let lg = |a: f64| a.max(1e-9).log10();
+    let mut series: Vec<Series> = tests
+        .iter()
+        .enumerate()
+        .map(|(i, (id, pts))| {
+            Series::dots(
+                &format!("test {id}"),
+                PALETTE[i % PALETTE.len()],
+                pts.iter().map(|&(a, r)| (lg(a), r)).collect(),
+            )
+        })
+        .collect();
+    series.push(Series::line("law r(a)", BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
+    series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
+    series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
+    let span = law.first().zip(law.last()).map(|(a, b)| (lg(a.0), lg(b.0)));
+    if let Some((x0, x1)) = span {
+        series.push(Series::line(
+            &format!("constant r = {constant:.3}"),
+            ORANGE,
+            vec![(x0, constant), (x1, constant)],
+        ));
+    }
+    Panel::new(
+        title,
+        "log10 of the amplitude |θ|/α at the apex of the half-cycle the impact ends",
+        "r = e / e_H",
+        series,
+    )
+}

@@ -5,9 +5,12 @@ use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::Value;
 
 use crate::campaign_means::Means;
+use crate::impacts::{ImpactCoefficient, ImpactTable};
+use crate::law_fit::{LawFit, SideFit};
 use crate::peaks::{Impact, Peak};
 use crate::reduce::{CampaignResult, TestOutcome};
 use crate::restitution::Coefficients;
+use crate::restitution_law::{CurvePoint, RestitutionLaw};
 
 /// The standard uncertainties of a test's coefficients, each key with `_u`
 /// appended (`r_plus_u` beside `r_plus`).
@@ -36,7 +39,87 @@ struct Reduction<'a> {
     #[serde(flatten)]
     u: Option<Uncertainties<'a>>,
     release_time_s: f64,
-    impacts: &'a [Impact],
+    impacts: Vec<ImpactDoc<'a>>,
+}
+
+/// One entry of a test's `"impacts"`: the analysis' impact (time, side entered,
+/// signed speeds) and, where the next peak was fitted, its coefficient (SPEC).
+#[derive(serde::Serialize)]
+struct ImpactDoc<'a> {
+    #[serde(flatten)]
+    impact: &'a Impact,
+    #[serde(flatten)]
+    coefficient: Option<&'a ImpactCoefficient>,
+}
+
+fn impact_docs(t: &ImpactTable) -> Vec<ImpactDoc<'_>> {
+    t.raw
+        .iter()
+        .enumerate()
+        .map(|(k, impact)| ImpactDoc {
+            impact,
+            coefficient: t.impacts.get(k),
+        })
+        .collect()
+}
+
+/// `"restitution_law"`: the law (form, parameters), its curve, and its test against
+/// the constant pair; or why there is none.
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+enum LawDoc<'a> {
+    Fitted {
+        #[serde(flatten)]
+        law: &'a RestitutionLaw,
+        curve: Vec<CurvePoint>,
+        constant: ConstantDoc,
+        fits: Vec<FitDoc<'a>>,
+        rejects_constant: bool,
+        tests: &'a [String],
+    },
+    Missing {
+        error: String,
+    },
+}
+
+#[derive(serde::Serialize)]
+struct ConstantDoc {
+    r_in: f64,
+    r_in_u: f64,
+    r_out: f64,
+    r_out_u: f64,
+}
+
+#[derive(serde::Serialize)]
+struct FitDoc<'a> {
+    side: &'a str,
+    #[serde(flatten)]
+    fit: &'a SideFit,
+}
+
+/// The number of points of the law's curve in summary.json (SPEC: at least 20).
+pub const CURVE_POINTS: usize = 25;
+
+fn law_doc(law: &Result<LawFit, crate::law_fit::LawFitError>) -> LawDoc<'_> {
+    match law {
+        Ok(f) => {
+            let c = &f.constant.parameters;
+            LawDoc::Fitted {
+                law: &f.law,
+                curve: f.law.curve(CURVE_POINTS),
+                constant: ConstantDoc {
+                    r_in: c.inward.r_inf,
+                    r_in_u: c.inward.cov[0][0].sqrt(),
+                    r_out: c.outward.r_inf,
+                    r_out_u: c.outward.cov[0][0].sqrt(),
+                },
+                fits: f.sides.iter().map(|(side, fit)| FitDoc { side, fit }).collect(),
+                rejects_constant: f.rejects_constant,
+                tests: &f.tests_used,
+            }
+        }
+        Err(e) => LawDoc::Missing { error: e.to_string() },
+    }
 }
 
 /// One entry of `"tests"`.
@@ -65,7 +148,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 coefficients: &r.coefficients,
                 u: r.uncertainty.as_ref().map(Uncertainties),
                 release_time_s: r.analysis.release_time_s,
-                impacts: &r.analysis.impacts,
+                impacts: impact_docs(&r.impacts),
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }
@@ -103,6 +186,7 @@ struct SummaryDoc<'a> {
     mean_u: Option<&'a Means>,
     mean_included: &'a [String],
     mean_left_out: Vec<LeftOut<'a>>,
+    restitution_law: LawDoc<'a>,
 }
 
 /// Build the summary document (SPEC "the output contract"); its keys sorted as
@@ -122,6 +206,7 @@ pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
         mean_u: res.means.means_u.as_ref(),
         mean_included: &res.means.included,
         mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
+        restitution_law: law_doc(&res.law),
     };
     Ok(serde_json::to_value(doc)?)
 }

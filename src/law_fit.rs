@@ -1,0 +1,394 @@
+//! The campaign's restitution law fitted to every impact of every test
+//! ([`crate::impacts`]), and whether the data reject a constant.
+//!
+//! # The fit
+//! The form ([`crate::restitution_law`]) is linear in its parameters:
+//! r_i = r∞ − c g(a_i) + ε_i, so it is fitted by generalised least squares with the
+//! covariance C of the impacts' r (block-diagonal over tests; within a test the full
+//! J Σ_v Jᵀ, so that two ratios sharing a peak and the fully correlated model-form
+//! terms are weighted as they are):
+//!
+//!   β = (Xᵀ C⁻¹ X)⁻¹ Xᵀ C⁻¹ y,   χ² = (y − Xβ)ᵀ C⁻¹ (y − Xβ),   X_i = (1, −g(a_i)).
+//!
+//! One-sided rocking fits each side on its own impacts; two-sided rocking fits one
+//! law to all impacts (the sides are the same contact). Where χ²/ν > 1 (the
+//! impacts scatter more than their u say: one-sided, the transverse walls differ from
+//! test to test) the covariance of β is scaled by s² = χ²/ν (Birge ratio), so the
+//! law's band is never narrower than the scatter it was fitted to.
+//!
+//! # The constant
+//! The constant is the same fit with X_i = (1). The law rejects it on a side when
+//!
+//!   F = (χ²_const − χ²_law) / s²,   s² = max(1, χ²_law/ν),
+//!
+//! is improbable under the constant: p = P(F(1, ν) > F) where s² > 1 (the residual
+//! variance estimated, the F test), p = P(χ²(1) > F) where the stated u already cover
+//! the scatter (the likelihood-ratio test). The data reject the constant when a side's
+//! p is below 0.01 / (number of sides tested) (Bonferroni).
+//!
+//! The incomplete beta function (for the F distribution) is Numerical Recipes §6.4
+//! (continued fraction by the modified Lentz method; ln Γ by Lanczos, §6.1): a dozen
+//! lines no crate of ours carries.
+
+use nalgebra::{DMatrix, DVector};
+
+use crate::impacts::ImpactTable;
+use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, SideLaw, AMPLITUDE_FLOOR};
+use crate::wall::{Rocking, Side};
+
+/// Level of the test against a constant (before the Bonferroni split over sides).
+pub const ALPHA_TEST: f64 = 0.01;
+
+/// One test's impacts as the fit takes them.
+#[derive(Debug, Clone, Copy)]
+pub struct TestImpacts<'a> {
+    pub id: &'a str,
+    pub table: &'a ImpactTable,
+}
+
+/// The fit of one side (or of both, two-sided).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SideFit {
+    pub impacts: usize,
+    /// ν = impacts − 2.
+    pub dof: usize,
+    pub chi2_law: f64,
+    pub chi2_constant: f64,
+    /// s² = max(1, χ²_law/ν).
+    pub scale: f64,
+    /// The weighted constant r and its u (scaled as the law's).
+    pub constant_r: f64,
+    pub constant_u: f64,
+    pub statistic: f64,
+    pub p_value: f64,
+}
+
+/// The campaign's law and its test against a constant.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LawFit {
+    pub law: RestitutionLaw,
+    /// The fits: ("in", "out") one-sided, ("both") two-sided.
+    pub sides: Vec<(String, SideFit)>,
+    /// Whether some side's p is below [`ALPHA_TEST`] / (sides tested).
+    pub rejects_constant: bool,
+    /// The best constant pair (the weighted constant of each side).
+    pub constant: RestitutionLaw,
+    pub tests_used: Vec<String>,
+}
+
+/// Why no law could be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LawFitError {
+    #[error("no test has per-impact uncertainties (the default estimator gives them)")]
+    NoUncertainties,
+    #[error("side {side}: {n} impacts with uncertainties; the law needs at least 4 (two parameters and two degrees of freedom)")]
+    TooFewImpacts { side: &'static str, n: usize },
+    #[error("side {0}: the impacts' amplitudes do not spread enough to tell r∞ from c")]
+    NotIdentifiable(&'static str),
+}
+
+/// Accumulated normal equations of the GLS: XᵀWX, XᵀWy, yᵀWy for p parameters.
+struct Normal {
+    xtwx: DMatrix<f64>,
+    xtwy: DVector<f64>,
+    ytwy: f64,
+    n: usize,
+    a_min: f64,
+    a_max: f64,
+}
+
+impl Normal {
+    fn new(p: usize) -> Normal {
+        Normal {
+            xtwx: DMatrix::zeros(p, p),
+            xtwy: DVector::zeros(p),
+            ytwy: 0.0,
+            n: 0,
+            a_min: f64::INFINITY,
+            a_max: 0.0,
+        }
+    }
+
+    /// Adds one test's impacts `idx` with design rows from `row`.
+    fn add(&mut self, table: &ImpactTable, cov: &[Vec<f64>], idx: &[usize], row: &dyn Fn(f64) -> Vec<f64>) {
+        let m = idx.len();
+        let p = self.xtwy.len();
+        let mut c = DMatrix::from_fn(m, m, |i, j| cov[idx[i]][idx[j]]);
+        // A ridge of 1e-9 of the mean variance keeps a fully correlated block invertible.
+        let ridge = 1e-9 * (0..m).map(|i| c[(i, i)]).sum::<f64>() / m as f64;
+        for i in 0..m {
+            c[(i, i)] += ridge.max(1e-18);
+        }
+        let Some(w) = c.try_inverse() else { return };
+        let x = DMatrix::from_fn(m, p, |i, j| row(table.impacts[idx[i]].amplitude_over_alpha)[j]);
+        let y = DVector::from_fn(m, |i, _| table.impacts[idx[i]].r);
+        let xtw = x.transpose() * &w;
+        self.xtwx += &xtw * &x;
+        self.xtwy += &xtw * &y;
+        self.ytwy += (y.transpose() * &w * &y)[(0, 0)];
+        self.n += m;
+        for &i in idx {
+            let a = table.impacts[i].amplitude_over_alpha;
+            self.a_min = self.a_min.min(a);
+            self.a_max = self.a_max.max(a);
+        }
+    }
+
+    /// β, its unscaled covariance (XᵀWX)⁻¹ and χ².
+    fn solve(&self) -> Option<(DVector<f64>, DMatrix<f64>, f64)> {
+        let inv = self.xtwx.clone().try_inverse()?;
+        let beta = &inv * &self.xtwy;
+        let chi2 = (self.ytwy - (beta.transpose() * &self.xtwy)[(0, 0)]).max(0.0);
+        Some((beta, inv, chi2))
+    }
+}
+
+fn law_row(a: f64) -> Vec<f64> {
+    vec![1.0, -speed_shape(a.max(AMPLITUDE_FLOOR))]
+}
+
+fn const_row(_: f64) -> Vec<f64> {
+    vec![1.0]
+}
+
+/// The fit of the impacts of `sides` (one side, or both for two-sided rocking).
+fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Result<(SideLaw, SideFit, (f64, f64)), LawFitError> {
+    let mut law = Normal::new(2);
+    let mut cst = Normal::new(1);
+    for t in tests {
+        let Some(cov) = &t.table.r_cov else { continue };
+        let idx: Vec<usize> = (0..t.table.impacts.len())
+            .filter(|&i| sides.contains(&t.table.impacts[i].side) && t.table.impacts[i].r.is_finite() && cov[i][i] > 0.0)
+            .collect();
+        if idx.is_empty() {
+            continue;
+        }
+        law.add(t.table, cov, &idx, &law_row);
+        cst.add(t.table, cov, &idx, &const_row);
+    }
+    if law.n < 4 {
+        return Err(LawFitError::TooFewImpacts { side: label, n: law.n });
+    }
+    let (beta, inv, chi2_l) = law.solve().ok_or(LawFitError::NotIdentifiable(label))?;
+    let (beta_c, inv_c, chi2_c) = cst.solve().ok_or(LawFitError::NotIdentifiable(label))?;
+    // Amplitudes that hardly spread leave c undetermined: its u then exceeds the whole
+    // change of r over the observed range many times over.
+    let g_span = speed_shape(law.a_min.max(AMPLITUDE_FLOOR)) - speed_shape(law.a_max.max(AMPLITUDE_FLOOR));
+    if !(g_span > 1e-6) || !inv[(1, 1)].is_finite() {
+        return Err(LawFitError::NotIdentifiable(label));
+    }
+    let dof = law.n - 2;
+    let scale = (chi2_l / dof as f64).max(1.0);
+    let statistic = (chi2_c - chi2_l).max(0.0) / scale;
+    let p_value = if scale > 1.0 {
+        f_sf(statistic, 1.0, dof as f64)
+    } else {
+        chi2_1_sf(statistic)
+    };
+    let cov = [[inv[(0, 0)] * scale, inv[(0, 1)] * scale], [inv[(1, 0)] * scale, inv[(1, 1)] * scale]];
+    let c_scale = (chi2_c / (law.n - 1) as f64).max(1.0);
+    let side = SideLaw {
+        r_inf: beta[0],
+        c: beta[1],
+        cov,
+    };
+    let fit = SideFit {
+        impacts: law.n,
+        dof,
+        chi2_law: chi2_l,
+        chi2_constant: chi2_c,
+        scale,
+        constant_r: beta_c[0],
+        constant_u: (inv_c[(0, 0)] * c_scale).sqrt(),
+        statistic,
+        p_value,
+    };
+    Ok((side, fit, (law.a_min, law.a_max)))
+}
+
+/// The campaign's law from its tests' impacts (module docs). The caller passes only
+/// the tests the campaign vouches for (status ok, not excluded from the means).
+pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFitError> {
+    if tests.iter().all(|t| t.table.r_cov.is_none()) {
+        return Err(LawFitError::NoUncertainties);
+    }
+    let groups: Vec<(&'static str, Vec<Side>)> = match rocking {
+        Rocking::TwoSided => vec![("both", vec![Side::Inward, Side::Outward])],
+        Rocking::OneSided => vec![("in", vec![Side::Inward]), ("out", vec![Side::Outward])],
+    };
+    let mut fitted = Vec::new();
+    for (label, sides) in &groups {
+        fitted.push((*label, fit_group(tests, sides, label)?));
+    }
+    let (a_min, a_max) = fitted.iter().fold((1.0f64, 0.0f64), |(lo, hi), f| (lo.min(f.1 .2 .0), hi.max(f.1 .2 .1)));
+    let (inward, outward) = (fitted[0].1 .0, fitted[fitted.len() - 1].1 .0);
+    let (fin, fout) = (fitted[0].1 .1, fitted[fitted.len() - 1].1 .1);
+    let law = RestitutionLaw {
+        form: LawForm::SpeedLoss,
+        parameters: LawParameters {
+            inward,
+            outward,
+            shared: rocking == Rocking::TwoSided,
+            amplitude_min: a_min.clamp(AMPLITUDE_FLOOR, 1.0),
+            amplitude_max: a_max.clamp(a_min.clamp(AMPLITUDE_FLOOR, 1.0), 1.0),
+        },
+    };
+    let level = ALPHA_TEST / fitted.len() as f64;
+    let mut constant = RestitutionLaw::constant(fin.constant_r, fin.constant_u, fout.constant_r, fout.constant_u);
+    constant.parameters.shared = law.parameters.shared;
+    Ok(LawFit {
+        rejects_constant: fitted.iter().any(|f| f.1 .1.p_value < level),
+        sides: fitted.iter().map(|f| (f.0.to_string(), f.1 .1)).collect(),
+        law,
+        constant,
+        tests_used: tests.iter().filter(|t| t.table.r_cov.is_some()).map(|t| t.id.to_string()).collect(),
+    })
+}
+
+/// P(χ²(1) > x) = erfc(√(x/2)).
+fn chi2_1_sf(x: f64) -> f64 {
+    crate::stats::erfc((x / 2.0).sqrt())
+}
+
+/// P(F(d1, d2) > f) = I_{d2/(d2 + d1 f)}(d2/2, d1/2).
+pub fn f_sf(f: f64, d1: f64, d2: f64) -> f64 {
+    if f <= 0.0 {
+        return 1.0;
+    }
+    beta_reg(d2 / 2.0, d1 / 2.0, d2 / (d2 + d1 * f))
+}
+
+/// ln Γ(x), Lanczos (Numerical Recipes §6.1), |error| < 2e-10 for x > 0.
+fn ln_gamma(x: f64) -> f64 {
+    const C: [f64; 6] = [
+        76.18009172947146,
+        -86.50532032941677,
+        24.01409824083091,
+        -1.231739572450155,
+        0.1208650973866179e-2,
+        -0.5395239384953e-5,
+    ];
+    let tmp = x + 5.5 - (x + 0.5) * (x + 5.5).ln();
+    let ser = C.iter().enumerate().fold(1.000000000190015, |s, (j, c)| s + c / (x + 1.0 + j as f64));
+    -tmp + (2.5066282746310005 * ser / x).ln()
+}
+
+/// The regularised incomplete beta function I_x(a, b) (Numerical Recipes §6.4).
+pub fn beta_reg(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let front = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    if x < (a + 1.0) / (a + b + 2.0) {
+        front * beta_cf(a, b, x) / a
+    } else {
+        1.0 - front * beta_cf(b, a, 1.0 - x) / b
+    }
+}
+
+/// The continued fraction of I_x(a, b) by the modified Lentz method.
+fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
+    let tiny = 1e-300;
+    let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
+    let mut c = 1.0;
+    let mut d = 1.0 - qab * x / qap;
+    d = 1.0 / if d.abs() < tiny { tiny } else { d };
+    let mut h = d;
+    for m in 1..300 {
+        let m = m as f64;
+        let m2 = 2.0 * m;
+        for aa in [
+            m * (b - m) * x / ((qam + m2) * (a + m2)),
+            -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2)),
+        ] {
+            d = 1.0 + aa * d;
+            d = 1.0 / if d.abs() < tiny { tiny } else { d };
+            c = 1.0 + aa / c;
+            c = if c.abs() < tiny { tiny } else { c };
+            h *= d * c;
+            if aa == 0.0 {
+                break;
+            }
+        }
+        if (d * c - 1.0).abs() < 3e-15 {
+            break;
+        }
+    }
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::impacts::ImpactCoefficient;
+
+    /// F(1, ν) = t²(ν): P(F(1, 10) > 4.9646) = 0.05 (tables: t₀.₉₇₅(10) = 2.2281);
+    /// P(F(2, 20) > 3.4928) = 0.05; I_x(1, 1) = x.
+    #[test]
+    fn f_distribution_by_tables() {
+        assert!((f_sf(2.228139f64.powi(2), 1.0, 10.0) - 0.05).abs() < 1e-5);
+        assert!((f_sf(3.492828, 2.0, 20.0) - 0.05).abs() < 1e-5);
+        assert!((beta_reg(1.0, 1.0, 0.3) - 0.3).abs() < 1e-12);
+        assert!((chi2_1_sf(3.841459) - 0.05).abs() < 1e-6);
+    }
+
+    fn table(points: &[(f64, f64, Side)], u: f64) -> ImpactTable {
+        let impacts = points
+            .iter()
+            .enumerate()
+            .map(|(k, &(a, r, side))| ImpactCoefficient {
+                k,
+                side,
+                amplitude_over_alpha: a,
+                speed_before_mm_s: 1.0,
+                speed_after_mm_s: r,
+                e: r,
+                e_u: Some(u),
+                r,
+                r_u: Some(u),
+            })
+            .collect::<Vec<_>>();
+        let n = impacts.len();
+        let cov = (0..n).map(|i| (0..n).map(|j| if i == j { u * u } else { 0.0 }).collect()).collect();
+        ImpactTable {
+            impacts,
+            r_cov: Some(cov),
+            raw: Vec::new(),
+        }
+    }
+
+    /// Exact data on the form are recovered exactly, and the constant is rejected;
+    /// constant data (with scatter) are not.
+    #[test]
+    fn recovers_a_law_and_keeps_a_constant() {
+        let amps = [0.3, 0.2, 0.12, 0.08, 0.05, 0.03, 0.02];
+        let pts: Vec<(f64, f64, Side)> = amps.iter().map(|&a| (a, 1.02 - 0.03 * speed_shape(a), Side::Inward)).collect();
+        let t = table(&pts, 0.003);
+        let fit = fit_law(Rocking::TwoSided, &[TestImpacts { id: "a", table: &t }]).unwrap();
+        let p = fit.law.parameters.inward;
+        assert!((p.r_inf - 1.02).abs() < 1e-9 && (p.c - 0.03).abs() < 1e-9, "{p:?}");
+        assert!(fit.rejects_constant, "{:?}", fit.sides);
+        // A constant 0.9 with ±0.01 alternating scatter: no trend, the constant stands.
+        let pts: Vec<(f64, f64, Side)> = amps
+            .iter()
+            .enumerate()
+            .map(|(i, &a)| (a, 0.9 + 0.01 * if i % 2 == 0 { 1.0 } else { -1.0 }, Side::Inward))
+            .collect();
+        let t = table(&pts, 0.003);
+        let fit = fit_law(Rocking::TwoSided, &[TestImpacts { id: "a", table: &t }]).unwrap();
+        assert!(!fit.rejects_constant, "{:?}", fit.sides);
+        assert!((fit.constant.parameters.inward.r_inf - 0.9).abs() < 0.005);
+        // The band covers the scatter: s² = χ²/ν > 1 scales it.
+        assert!(fit.sides[0].1.scale > 1.0);
+    }
+
+    #[test]
+    fn too_few_impacts_is_an_error() {
+        let t = table(&[(0.3, 0.9, Side::Inward), (0.2, 0.9, Side::Inward)], 0.01);
+        let e = fit_law(Rocking::TwoSided, &[TestImpacts { id: "a", table: &t }]).unwrap_err();
+        assert!(matches!(e, LawFitError::TooFewImpacts { n: 2, .. }), "{e}");
+    }
+}

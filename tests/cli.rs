@@ -248,8 +248,8 @@ fn format_invariance() {
 /// Regression for issue #2: `demo` writes tables and plots for both campaigns.
 /// Issue 10: and the façade's P(overturn) table for Housner, the paper's pair and
 /// this campaign's calibration, with the fragility plot (small ensembles: debug
-/// build). Issue 20: and a law set for each one-sided campaign whose summary.json
-/// holds a restitution law (the demo's own and mujoco-public-one-sided).
+/// build). Issue 20: and, for each one-sided campaign (the demo's own and
+/// mujoco-public-one-sided), its restitution law and its constant pair as sets.
 #[test]
 fn demo_writes_tables_and_plots() {
     let dir = tempfile::tempdir().unwrap();
@@ -269,11 +269,13 @@ fn demo_writes_tables_and_plots() {
     let s: Value = serde_json::from_str(&std::fs::read_to_string(f.join("summary.json")).unwrap()).unwrap();
     let rows = s["ensemble"]["rows"].as_array().unwrap();
     let mut sets = vec!["housner", "calibrated", "campaign"];
-    for (c, name) in [("one-sided-demo", "campaign law"), ("mujoco-public-one-sided", "mujoco law")] {
+    for (c, law, constant) in [
+        ("one-sided-demo", "campaign law", "campaign constant"),
+        ("mujoco-public-one-sided", "mujoco law", "mujoco constant"),
+    ] {
         let summary: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join(c).join("summary.json")).unwrap()).unwrap();
-        if summary.get("restitution_law").is_some() {
-            sets.push(name);
-        }
+        assert!(summary.get("restitution_law").is_some(), "{c}: no law");
+        sets.extend([law, constant]);
     }
     assert_eq!(rows.len(), 3 * 2 * sets.len(), "records × polarities × sets");
     for &set in &sets {

@@ -33,10 +33,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let set = rocklab::facade::calibration_set("campaign", &cal_path.display().to_string(), &cal, "tests").map_err(|e| anyhow::anyhow!(e))?;
     study.sets.push(set);
     ok &= reduce_for_law(&args, "mujoco-public-one-sided")?;
-    for (campaign, name) in [("one-sided-demo", "campaign law"), ("mujoco-public-one-sided", "mujoco law")] {
-        if let Some(set) = law_set(&args, &study, campaign, name)? {
-            study.sets.push(set);
-        }
+    for (campaign, name) in [("one-sided-demo", "campaign"), ("mujoco-public-one-sided", "mujoco")] {
+        study.sets.extend(law_sets(&args, &study, campaign, name)?);
     }
     let scales = rocklab::facade::parse_scales(&args.scales)?;
     say(&format!(
@@ -64,28 +62,43 @@ fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
     Ok(ok)
 }
 
-/// The law set `name` from the summary.json the demo wrote for `campaign` (its
-/// parameters drawn from their covariance, e_H by Eq. 2 with the façade's α);
-/// None, said on the terminal, when the summary holds no law.
-fn law_set(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Option<rocklab::facade::CoefficientSet>> {
+/// The law sets of `campaign` from the summary.json the demo wrote for it: "NAME
+/// law" (the fitted law) and "NAME constant" (the best constant pair of the same
+/// impacts, `restitution_law.constant`, as a constant law), both as r × e_H by
+/// Eq. 2 with the façade's α and drawn from their covariance, so that the two
+/// differ only in the law's form. None, said on the terminal, when the summary
+/// holds no law.
+fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Vec<rocklab::facade::CoefficientSet>> {
+    use rocklab::facade::CoefficientSet;
+    use rocklab::restitution_law::RestitutionLaw;
     let path = args.out.join(campaign).join("summary.json");
-    let text = std::fs::read_to_string(&path)?;
-    let doc: serde_json::Value = serde_json::from_str(&text)?;
-    if doc.get("restitution_law").is_none() {
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)?;
+    let Some(fitted) = doc.get("restitution_law") else {
         say(&format!(
-            "{}: no restitution_law, so the façade study has no \"{name}\" set",
+            "{}: no restitution_law, so the façade study has no \"{name} law\" set",
             path.display()
         ));
-        return Ok(None);
-    }
+        return Ok(Vec::new());
+    };
+    let alpha = study.block.block.alpha;
     let law = rocklab::ingest::law::read(&path)?;
-    let source = format!("law {} ({})", path.display(), law.form.as_str());
-    Ok(Some(rocklab::facade::CoefficientSet::law(
-        name,
+    let mut sets = vec![CoefficientSet::law(
+        &format!("{name} law"),
         law,
         None,
-        study.block.block.alpha,
+        alpha,
         true,
-        source,
-    )))
+        format!("law {} ({})", path.display(), law.form.as_str()),
+    )];
+    let c = &fitted["constant"];
+    let num = |k: &str| {
+        c[k].as_f64()
+            .ok_or_else(|| anyhow::anyhow!("{}: restitution_law.constant.{k}: expected a number", path.display()))
+    };
+    if c.is_object() {
+        let constant = RestitutionLaw::constant(num("r_in")?, num("r_in_u")?, num("r_out")?, num("r_out_u")?);
+        let source = format!("the constant pair of {}", path.display());
+        sets.push(CoefficientSet::law(&format!("{name} constant"), constant, None, alpha, true, source));
+    }
+    Ok(sets)
 }

@@ -37,10 +37,12 @@
 //! fits one law for both sides (`shared`: in and out are equal and drawn together).
 //!
 //! # Range
-//! Below the smallest amplitude the campaign observed (`amplitude_min`) the law holds
-//! its value there (no extrapolation towards g → ∞); above it the form extrapolates to
-//! a = 1, where g is bounded (g(1) = 1), which is what a façade near overturning needs.
-//! r is never below 0; [`RestitutionLaw::e`] caps e = r e_H at 1.
+//! Above the largest amplitude the campaign observed the form extrapolates to a = 1,
+//! where g is bounded (g(1) = 1), which is what a façade near overturning needs.
+//! Below the smallest (`amplitude_min`) it extrapolates where r falls with the
+//! amplitude (c ≥ 0: the fixed speed loss brings the wall to rest, as it does; r is
+//! never below 0) and holds its value at `amplitude_min` where r would rise without
+//! bound (c < 0). [`RestitutionLaw::e`] caps e = r e_H at 1.
 //!
 //! # Uncertainty and draws
 //! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c).
@@ -224,15 +226,17 @@ impl RestitutionLaw {
         }
     }
 
-    /// g at the amplitude, a clamped to [amplitude_min, 1] (module docs, "Range"); 0
-    /// for a constant, so that r = r∞ exactly.
-    fn g(&self, amplitude_over_alpha: f64) -> f64 {
+    /// g at the amplitude for one side (module docs, "Range"): a clamped to
+    /// [AMPLITUDE_FLOOR, 1] where c ≥ 0 and to [amplitude_min, 1] where c < 0; 0 for
+    /// a constant, so that r = r∞ exactly.
+    fn g(&self, side: &SideLaw, amplitude_over_alpha: f64) -> f64 {
         match self.form {
             LawForm::Constant => 0.0,
             LawForm::SpeedLoss => {
                 let a = amplitude_over_alpha.abs();
                 let a = if a.is_finite() { a } else { 1.0 };
-                speed_shape(a.clamp(self.parameters.amplitude_min, 1.0))
+                let lo = if side.c >= 0.0 { AMPLITUDE_FLOOR } else { self.parameters.amplitude_min };
+                speed_shape(a.clamp(lo, 1.0))
             }
         }
     }
@@ -240,12 +244,14 @@ impl RestitutionLaw {
     /// r of an impact entering `side` that ends a half-cycle of apex |θ|/α =
     /// `amplitude_over_alpha`: max(0, r∞ − c g(a)).
     pub fn r(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
-        self.side(side).value(self.g(amplitude_over_alpha)).max(0.0)
+        let l = self.side(side);
+        l.value(self.g(l, amplitude_over_alpha)).max(0.0)
     }
 
     /// The standard uncertainty of [`Self::r`] from the parameters' covariance.
     pub fn r_u(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
-        self.side(side).u(self.g(amplitude_over_alpha))
+        let l = self.side(side);
+        l.u(self.g(l, amplitude_over_alpha))
     }
 
     /// The coefficient the solver applies: e = min(1, r(a) e_H).
@@ -353,8 +359,13 @@ mod tests {
         let g = 1.0 / 0.75f64.sqrt();
         assert!((l.r(Side::Outward, 0.5) - (1.02 - 0.02 * g)).abs() < 1e-15);
         assert_eq!(l.r(Side::Inward, 0.5), 0.70);
-        // Below amplitude_min the law holds its value at amplitude_min.
-        assert_eq!(l.r(Side::Outward, 1e-5), l.r(Side::Outward, 0.01));
+        // Below amplitude_min a falling side (c > 0) extrapolates, down to r = 0 …
+        assert!((l.r(Side::Outward, 0.001) - (1.02 - 0.02 / (0.001f64 * 1.999).sqrt())).abs() < 1e-12);
+        assert_eq!(l.r(Side::Outward, 1e-6), 0.0);
+        // … and a rising side (c < 0) holds its value at amplitude_min.
+        let mut up = l;
+        up.parameters.inward.c = -0.01;
+        assert_eq!(up.r(Side::Inward, 1e-5), up.r(Side::Inward, 0.01));
         // u² = Σ00 − 2 g Σ01 + g² Σ11.
         let u = (4e-4 + 2.0 * g * 2e-5 + g * g * 4e-6f64).sqrt();
         assert!((l.r_u(Side::Outward, 0.5) - u).abs() < 1e-15);

@@ -2,7 +2,7 @@
 //! every test), the restitution-law plot (`plots/restitution_law.{png,svg}`) and its
 //! section of report.html.
 
-use super::html::escape;
+use super::table::escape;
 use super::plots::{self, Figure};
 use super::{Files, ReportError};
 use crate::impacts::side_label;

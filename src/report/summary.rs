@@ -75,6 +75,7 @@ enum LawDoc<'a> {
         constant: ConstantDoc,
         fits: Vec<FitDoc<'a>>,
         rejects_constant: bool,
+        speed_loss_fit: &'a RestitutionLaw,
         tests: &'a [String],
     },
     Missing {
@@ -115,6 +116,7 @@ fn law_doc(law: &Result<LawFit, crate::law_fit::LawFitError>) -> LawDoc<'_> {
                 },
                 fits: f.sides.iter().map(|(side, fit)| FitDoc { side, fit }).collect(),
                 rejects_constant: f.rejects_constant,
+                speed_loss_fit: &f.speed_loss,
                 tests: &f.tests_used,
             }
         }

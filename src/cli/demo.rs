@@ -66,8 +66,9 @@ fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
 /// law" (the fitted law) and "NAME constant" (the best constant pair of the same
 /// impacts, `restitution_law.constant`, as a constant law), both as r × e_H by
 /// Eq. 2 with the façade's α and drawn from their covariance, so that the two
-/// differ only in the law's form. None, said on the terminal, when the summary
-/// holds no law.
+/// differ only in the law's form (the constant set is left out when the fitted
+/// law is itself the constant: the data did not reject it). None, said on the
+/// terminal, when the summary holds no law.
 fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Vec<rocklab::facade::CoefficientSet>> {
     use rocklab::facade::CoefficientSet;
     use rocklab::restitution_law::RestitutionLaw;
@@ -95,7 +96,7 @@ fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, nam
         c[k].as_f64()
             .ok_or_else(|| anyhow::anyhow!("{}: restitution_law.constant.{k}: expected a number", path.display()))
     };
-    if c.is_object() {
+    if law.form != rocklab::restitution_law::LawForm::Constant {
         let constant = RestitutionLaw::constant(num("r_in")?, num("r_in_u")?, num("r_out")?, num("r_out_u")?);
         let source = format!("the constant pair of {}", path.display());
         sets.push(CoefficientSet::law(&format!("{name} constant"), constant, None, alpha, true, source));

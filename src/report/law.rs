@@ -2,8 +2,8 @@
 //! every test), the restitution-law plot (`plots/restitution_law.{png,svg}`) and its
 //! section of report.html.
 
-use super::table::escape;
 use super::plots::{self, Figure};
+use super::table::escape;
 use super::{Files, ReportError};
 use crate::impacts::side_label;
 use crate::law_fit::LawFit;

@@ -414,6 +414,13 @@ pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_
     })
 }
 
+/// What the calibration says of the restitution law (issue 20): the replay cannot
+/// fit it. The replay applies one pair (e_in, e_out) at every impact of a test, and
+/// its window holds the first few impacts, which span too little amplitude to tell
+/// r∞ from c; the law is fitted from every impact the reduction resolves instead
+/// ([`crate::law_fit`]).
+pub const LAW_BY_REPLAY: &str = "not fitted by replay: the replay applies one constant pair (e_in, e_out) at every impact of a test, and its window of the first impacts spans too little amplitude to tell the law's r_inf from c; the law is fitted from every impact the reduction resolves (summary.json restitution_law)";
+
 /// The campaign's calibration.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Calibration {

@@ -51,6 +51,8 @@ __all__ = [
     "EnsembleResult",
     "reduce",
     "reduce_log",
+    "impacts",
+    "restitution_law",
     "simulate",
     "calibrate",
     "facade",
@@ -225,6 +227,30 @@ def reduce(manifest: PathLike, *, method: str = "segments", window: int = 11, or
     """
     text, raw = _rocklab.reduce(os.fspath(manifest), method, window, order, series)
     return _reduce_result(json.loads(text), raw)
+
+
+def impacts(result: ReduceResult):
+    """Every impact of every reduced test with its coefficient (issue 20): one row per
+    impact of the summary's ``tests[].impacts`` that carries ``r``, with columns
+    ``test``, ``status`` and every field the impact has (``k``, ``side``,
+    ``amplitude_over_alpha``, ``speed_before_mm_s``, ``speed_after_mm_s``, ``e``,
+    ``e_u``, ``r``, ``r_u``, the time and signed speeds of the analysis). A DataFrame
+    where pandas is installed, else a list of dicts."""
+    rows = [
+        {"test": t["id"], "status": t.get("status"), **i}
+        for t in result.summary["tests"]
+        for i in t.get("impacts", [])
+        if "r" in i
+    ]
+    return _frame(rows)
+
+
+def restitution_law(result: ReduceResult) -> dict:
+    """The campaign's restitution law as the summary gives it (``restitution_law``:
+    ``form``, ``parameters`` per side with their covariance, ``curve`` with ``r_in``,
+    ``r_out`` and their u, the test against the constant); ``{"error": why}`` where
+    no law could be fitted."""
+    return result.summary["restitution_law"]
 
 
 def reduce_log(

@@ -38,7 +38,7 @@ def test_facade_equals_cli_summary_and_ida(cli, tmp_path):
     assert _runs_without_timing(res.summary["runs"]) == _runs_without_timing(expected["runs"])
     # facade runs the nominal study and the IDA; the CLI's summary also holds the
     # ensembles and fragility fits of issue #10, which facade_ensembles gives
-    # (test_law.py compares them with the CLI's).
+    # (test_facade_law.py compares them with the CLI's).
     drop = {"runs", TIMING, "ensemble", "fragility"}
     assert {k: v for k, v in res.summary.items() if k not in drop} == {k: v for k, v in expected.items() if k not in drop}
     ida = rocklab.read_csv(tmp_path / "ida.csv")

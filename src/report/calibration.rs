@@ -113,6 +113,7 @@ fn calibration_html(cal: &Calibration, n: usize, figs: &[Captioned]) -> String {
         cal.r_out,
         cal.e_housner
     );
+    s.push_str(&format!("<p>Restitution law: {}.</p>\n", escape(crate::calibrate::LAW_BY_REPLAY)));
     if let Some(j) = &cal.joint {
         s.push_str(&format!(
             "<p>One joint fit over the same tests: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",

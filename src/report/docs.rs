@@ -99,6 +99,8 @@ struct CalibrationDoc<'a> {
     per_impact: Vec<PerImpact<'a>>,
     failed: Vec<Failure<'a>>,
     wall_s: f64,
+    /// Why the restitution law is not fitted by replay (issue 20).
+    law_by_replay: &'static str,
 }
 
 /// The `"calibration"` entry that `rocklab calibrate` adds to `summary.json`;
@@ -116,6 +118,7 @@ pub fn calibration_summary(cal: &Calibration, wall_s: f64) -> Result<Value, Repo
         per_impact: cal.per_impact.iter().map(|(id, i, o)| PerImpact { id, inward: i, outward: o }).collect(),
         failed: cal.failed.iter().map(|(id, e)| Failure { id, error: e }).collect(),
         wall_s,
+        law_by_replay: crate::calibrate::LAW_BY_REPLAY,
     })?)
 }
 

@@ -170,7 +170,9 @@ fn two_sided_demo_keeps_a_constant() {
 /// (inward, largest-amplitude) impact of every test e/e_H = 0.32–0.37 and the later
 /// ones 0.45–0.95 at random (truth.json, `e_list_input`), the paper's r₁ effect. The
 /// fit sees that and rejects the constant inward; without impact 0 of each test it
-/// must not (the rest carries no trend with amplitude).
+/// must not (the rest carries no trend with amplitude). The inward speed-loss fit has
+/// c < 0 (r rising as the amplitude falls, a speed gain), so the law keeps the
+/// constant pair.
 #[test]
 fn one_sided_demo_rejects_only_through_its_first_impact() {
     use rocklab::impacts::ImpactTable;
@@ -179,6 +181,8 @@ fn one_sided_demo_rejects_only_through_its_first_impact() {
     let fit = res.law.as_ref().unwrap();
     println!("one-sided demo: {:?}", fit.sides);
     assert!(fit.rejects_constant);
+    assert!(fit.speed_loss.parameters.inward.c < 0.0);
+    assert_eq!(fit.law.form, rocklab::restitution_law::LawForm::Constant);
     let trimmed: Vec<(String, ImpactTable)> = res
         .tests
         .iter()

@@ -40,6 +40,7 @@ pub mod ground_motion;
 pub mod impacts;
 pub mod ingest;
 pub mod law_fit;
+pub mod limits;
 pub mod outcomes;
 pub mod peaks;
 pub mod reduction;

@@ -53,8 +53,9 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
         Vec::new()
     };
     for (id, motion, ratios) in &figs {
-        motion.add_to(&mut files, &format!("plots/{id}_motion"));
-        ratios.add_to(&mut files, &format!("plots/{id}_ratios"));
+        let stem = super::file_stem(id);
+        motion.add_to(&mut files, &format!("plots/{stem}_motion"));
+        ratios.add_to(&mut files, &format!("plots/{stem}_ratios"));
     }
     let mut sections = vec![super::law::law_files(res, with_plots, &mut files)?];
     sections.extend(extra.html_sections.iter().cloned());

@@ -210,5 +210,5 @@ pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
         mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
         restitution_law: law_doc(&res.law),
     };
-    Ok(serde_json::to_value(doc)?)
+    super::json_value(&doc)
 }

@@ -21,6 +21,27 @@ fn facade_ensemble_10000_runs(bencher: divan::Bencher) {
     });
 }
 
+/// Issue 20: 2,400 runs of the fixture study with its calibrated pair, or with the
+/// same pair as a constant restitution law whose r carries the pair's spread
+/// (r = e/e_H, u = sd/e_H: statistically the same runs), each sample drawing it.
+#[divan::bench(args = ["pair", "law"], sample_count = 3)]
+fn facade_ensemble_2400_runs_pair_or_law(bencher: divan::Bencher, how: &str) {
+    use rocklab::facade::CoefficientSet;
+    use rocklab::restitution_law::RestitutionLaw;
+    let mut study = Study::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/study.toml")).unwrap();
+    let e_h = study.e_housner_eq2;
+    study.sets.retain(|s| s.name == "calibrated");
+    if how == "law" {
+        let law = RestitutionLaw::constant(0.59 / e_h, 0.017 / e_h, 0.68 / e_h, 0.025 / e_h);
+        study.sets = vec![CoefficientSet::law("law", law, Some(e_h), study.block.block.alpha, true, "bench".into())];
+    }
+    let n = 2400 / (study.records.len() * study.rows().len());
+    bencher.bench(|| {
+        let (r, s) = run_ensembles(&study, n, &|| {}).unwrap();
+        divan::black_box((r.len(), s.len()))
+    });
+}
+
 /// One run that comes to rest at 21.5 s, long before the record ends (30 Oct 2016
 /// NRC ×1.27, polarity −1, e_in 0.59, e_out 0.68), with and without the early stop.
 #[divan::bench(args = [true, false])]
@@ -31,6 +52,7 @@ fn facade_run_resting_early_stop(bencher: divan::Bencher, stop: bool) {
     let spec = RunSpec {
         e_in: 0.59,
         e_out: 0.68,
+        law: None,
         scale: 1.27,
         polarity: -1.0,
         overturn_limit: 0.1,

@@ -30,6 +30,7 @@ fn spec(e_in: f64, e_out: f64, polarity: f64) -> RunSpec {
     RunSpec {
         e_in,
         e_out,
+        law: None,
         scale: 1.27,
         polarity,
         overturn_limit: 0.10,
@@ -45,6 +46,23 @@ fn facade_nrc_20161030_one_run(bencher: divan::Bencher) {
     let block = BlockSpec::load(&fixtures().join("facade/block.toml")).unwrap();
     let rec = record("IT.NRC..HGE.D.20161030.064018.C.ACC.ASC");
     let s = spec(0.59, 0.68, -1.0);
+    bencher.bench(|| divan::black_box(run(&block, &rec, &s).unwrap().0.max_theta_over_alpha));
+}
+
+/// Issue 20: the same run with the pair given as a constant restitution law
+/// (r = e/e_H, e_H = 0.985): the same trajectory bit for bit, so the difference is
+/// the law's cost (the apex tracked at every step, r read at each impact).
+#[divan::bench(args = ["pair", "constant law"])]
+fn facade_nrc_20161030_pair_or_law(bencher: divan::Bencher, how: &str) {
+    use rocklab::restitution_law::RestitutionLaw;
+    let block = BlockSpec::load(&fixtures().join("facade/block.toml")).unwrap();
+    let rec = record("IT.NRC..HGE.D.20161030.064018.C.ACC.ASC");
+    let e_h = 0.985;
+    let (r_in, r_out) = (0.59 / e_h, 0.68 / e_h);
+    let mut s = spec(r_in * e_h, r_out * e_h, -1.0);
+    if how != "pair" {
+        s.law = Some((RestitutionLaw::constant(r_in, 0.0, r_out, 0.0), e_h));
+    }
     bencher.bench(|| divan::black_box(run(&block, &rec, &s).unwrap().0.max_theta_over_alpha));
 }
 

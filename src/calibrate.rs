@@ -215,6 +215,7 @@ pub fn replay(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, nu: Nuisan
         ties: Vec::new(),
         e_in,
         e_out,
+        law: None,
         overturn_limit: std::f64::consts::FRAC_PI_2,
         linearized: false,
     };

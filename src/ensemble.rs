@@ -7,7 +7,8 @@
 //! coefficient sets share (magnification, geometry, restraint, a random polarity)
 //! from the stream keyed by (seed, record, polarity row, scale index, i, input), and
 //! the set's own e_in/e_out from the stream keyed by (seed, record, polarity row,
-//! scale index, i, set, input). Every draw is a pure function of its key
+//! scale index, i, set, input); a law set draws the four standard normals of its
+//! parameters ([`RestitutionLaw::sample`]) from one such stream. Every draw is a pure function of its key
 //! ([`SplitMix64::for_key`]), so the numbers do not depend on the thread count or
 //! on the order of the runs, and the sets are compared under common random
 //! numbers: sample i of Housner's set and sample i of the calibrated set see the
@@ -15,7 +16,9 @@
 //! comparison). Records and sets are keyed by a hash of their names, so
 //! reordering the study file changes nothing.
 
+use crate::restitution_law::RestitutionLaw;
 use crate::stats::{quantile_sorted, sorted, wilson, SplitMix64, Z95};
+use crate::wall::{housner_e, Side};
 
 /// The distribution of one uncertain input.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -140,20 +143,36 @@ impl Uncertainty {
 }
 
 /// The coefficients of a set as distributions: one e both ways (two-sided
-/// rocking, Housner) or e_in and e_out.
+/// rocking, Housner), e_in and e_out, or a restitution law.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CoefficientDist {
     Single(Dist),
-    Pair { e_in: Dist, e_out: Dist },
+    Pair {
+        e_in: Dist,
+        e_out: Dist,
+    },
+    /// e = min(1, r(side, a)·e_H) at each impact, a the apex |θ|/α of the
+    /// half-cycle it ends ([`crate::solver::impact`]); e_H as given, else Eq. 2
+    /// with the sample's α. When `drawn`, each sample draws the law's parameters
+    /// from their covariance ([`RestitutionLaw::sample`]).
+    Law {
+        law: RestitutionLaw,
+        e_housner: Option<f64>,
+        drawn: bool,
+    },
 }
 
 impl CoefficientDist {
-    /// Whether a sample draws e (a spread on either coefficient).
+    /// Whether a sample draws e (a spread on either coefficient, or on the law).
     pub fn is_random(&self) -> bool {
         match self {
             CoefficientDist::Single(d) => d.is_random(),
             CoefficientDist::Pair { e_in, e_out } => e_in.is_random() || e_out.is_random(),
+            CoefficientDist::Law { law, drawn, .. } => {
+                let p = &law.parameters;
+                *drawn && p.inward.cov.iter().chain(&p.outward.cov).flatten().any(|v| *v != 0.0)
+            }
         }
     }
 }
@@ -179,8 +198,13 @@ pub struct Inputs {
     pub i0: f64,
     /// (K'_c MN/m², contact height m) when the block has a spring bed.
     pub spring_bed: Option<(f64, f64)>,
+    /// The set's e_in and e_out; for a law set, the drawn law's e at a = 1 (the
+    /// amplitude of overturning), e_in of an impact entering inward.
     pub e_in: f64,
     pub e_out: f64,
+    /// A law set's drawn law and the e_H it is applied with.
+    #[serde(skip)]
+    pub law: Option<(RestitutionLaw, f64)>,
 }
 
 /// FNV-1a of a name: a stable key for records and sets.
@@ -238,12 +262,22 @@ pub fn draw(key: &SampleKey, unc: &Uncertainty, nominal: &Nominal, set_name: &st
     let polarity = polarity.unwrap_or_else(|| if key.stream(&[TAG_SHARED, 6]).uniform() < 0.5 { 1.0 } else { -1.0 });
     let s = name_key(set_name);
     let e = |i: u64, d: Dist| d.sample(&mut key.stream(&[TAG_SET, s, i]), 0.0, 1.0);
-    let (e_in, e_out) = match *set {
+    let (e_in, e_out, law) = match *set {
         CoefficientDist::Single(d) => {
             let v = e(0, d);
-            (v, v)
+            (v, v, None)
         }
-        CoefficientDist::Pair { e_in, e_out } => (e(1, e_in), e(2, e_out)),
+        CoefficientDist::Pair { e_in, e_out } => (e(1, e_in), e(2, e_out), None),
+        CoefficientDist::Law { law, e_housner, drawn } => {
+            let e_h = e_housner.unwrap_or_else(|| housner_e(alpha));
+            let law = if drawn {
+                let mut rng = key.stream(&[TAG_SET, s, 3]);
+                law.sample_with(|| rng.normal())
+            } else {
+                law
+            };
+            (law.e(Side::Inward, 1.0, e_h), law.e(Side::Outward, 1.0, e_h), Some((law, e_h)))
+        }
     };
     Inputs {
         magnification,
@@ -254,6 +288,7 @@ pub fn draw(key: &SampleKey, unc: &Uncertainty, nominal: &Nominal, set_name: &st
         spring_bed,
         e_in,
         e_out,
+        law,
     }
 }
 

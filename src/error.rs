@@ -53,6 +53,7 @@ pub enum FileKind {
     Block,
     Study,
     Calibration,
+    Law,
 }
 
 impl std::fmt::Display for FileKind {
@@ -62,6 +63,7 @@ impl std::fmt::Display for FileKind {
             FileKind::Block => "block file",
             FileKind::Study => "study",
             FileKind::Calibration => "calibration",
+            FileKind::Law => "restitution law",
         })
     }
 }

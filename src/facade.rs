@@ -1,7 +1,9 @@
 //! The façade study (paper §5): one block, several records, several coefficient
 //! sets, both polarities; optionally over a range of scale factors (incremental
-//! dynamic analysis). The study file format is documented in the README and in
-//! `fixtures/facade/study.toml`.
+//! dynamic analysis). The study file format is documented in docs/facade.md and in
+//! `fixtures/facade/study.toml`. A set is a constant pair (e_in, e_out) or a
+//! campaign's restitution law, applied at each impact at the apex of the
+//! half-cycle it ends ([`crate::solver::impact`]).
 
 use std::path::PathBuf;
 
@@ -11,12 +13,14 @@ use crate::calibrate::CalibrationValues;
 use crate::ensemble::{self, CoefficientDist, Dist, Inputs, Nominal, Outcome, PolarityMode, SampleKey, Uncertainty};
 use crate::fragility::{fit_lognormal, Fragility, FragilityError, Trial};
 use crate::ground_motion::Record;
+use crate::restitution_law::RestitutionLaw;
 use crate::solver::run::SolverError;
 use crate::solver::BlockSpec;
 use crate::study::{run, RunSpec, RunSummary};
-use crate::wall::Rocking;
+use crate::wall::{housner_e, Rocking, Side};
 
-/// A coefficient set of the study.
+/// A coefficient set of the study: a pair (e_in, e_out), or a restitution law
+/// (`dist` is [`CoefficientDist::Law`]; e_in and e_out are then its e at a = 1).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CoefficientSet {
     pub name: String,
@@ -130,6 +134,31 @@ pub enum SpreadError {
     Unknown(String),
 }
 
+impl CoefficientSet {
+    /// A set that applies a restitution law: e = min(1, r(side, a)·e_H) with e_H
+    /// as given, else Eq. 2 with the block's α (`alpha`); its parameters drawn
+    /// from their covariance in the ensembles when `drawn`.
+    pub fn law(name: &str, law: RestitutionLaw, e_housner: Option<f64>, alpha: f64, drawn: bool, source: String) -> CoefficientSet {
+        let e_h = e_housner.unwrap_or_else(|| housner_e(alpha));
+        CoefficientSet {
+            name: name.to_string(),
+            e_in: law.e(Side::Inward, 1.0, e_h),
+            e_out: law.e(Side::Outward, 1.0, e_h),
+            source,
+            dist: CoefficientDist::Law { law, e_housner, drawn },
+        }
+    }
+
+    /// The law of a law set and the e_H it is applied with on a block of
+    /// slenderness `alpha` (None: a constant pair).
+    pub fn law_at(&self, alpha: f64) -> Option<(RestitutionLaw, f64)> {
+        match self.dist {
+            CoefficientDist::Law { law, e_housner, .. } => Some((law, e_housner.unwrap_or_else(|| housner_e(alpha)))),
+            _ => None,
+        }
+    }
+}
+
 /// N(mean, sd), or the fixed mean when sd is 0 or not finite.
 pub fn normal_or_fixed(mean: f64, sd: f64) -> Dist {
     if sd > 0.0 && sd.is_finite() {
@@ -144,6 +173,7 @@ impl Study {
         RunSpec {
             e_in: set.e_in,
             e_out: set.e_out,
+            law: set.law_at(self.block.block.alpha),
             scale: self.magnification * scale,
             polarity,
             overturn_limit: self.overturn_limit,
@@ -367,6 +397,7 @@ impl Study {
         let spec = RunSpec {
             e_in: x.e_in,
             e_out: x.e_out,
+            law: x.law,
             scale: x.magnification * job.scale,
             polarity: x.polarity,
             overturn_limit: self.overturn_limit_given.unwrap_or(x.alpha),

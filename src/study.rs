@@ -1,15 +1,20 @@
 //! One seismic run of a block under a record (shared by `simulate` and the façade
 //! study): build the model, scale the record, integrate, summarise.
 
+use std::sync::Arc;
+
 use crate::ground_motion::Record;
+use crate::restitution_law::RestitutionLaw;
 use crate::solver::run::SolverError;
-use crate::solver::{simulate, BlockSpec, Ground, RockingModel, Settings, Simulation, Stop};
+use crate::solver::{simulate, BlockSpec, Ground, ImpactLaw, RockingModel, Settings, Simulation, Stop};
 
 /// Everything a run needs besides the block and the record.
 #[derive(Debug, Clone, Copy)]
 pub struct RunSpec {
     pub e_in: f64,
     pub e_out: f64,
+    /// A restitution law and the e_H it is applied with, instead of (e_in, e_out).
+    pub law: Option<(RestitutionLaw, f64)>,
     /// Magnification × user scale.
     pub scale: f64,
     /// ±1.
@@ -47,6 +52,7 @@ pub fn model(block: &BlockSpec, spec: &RunSpec) -> RockingModel {
         ties: block.ties.clone(),
         e_in: spec.e_in,
         e_out: spec.e_out,
+        law: spec.law.map(|(law, e_h)| ImpactLaw::new(Arc::new(law), e_h)),
         overturn_limit: spec.overturn_limit,
         linearized: false,
     }

@@ -248,7 +248,8 @@ fn format_invariance() {
 /// Regression for issue #2: `demo` writes tables and plots for both campaigns.
 /// Issue 10: and the façade's P(overturn) table for Housner, the paper's pair and
 /// this campaign's calibration, with the fragility plot (small ensembles: debug
-/// build).
+/// build). Issue 20: and, for each one-sided campaign (the demo's own and
+/// mujoco-public-one-sided), its restitution law and its constant pair as sets.
 #[test]
 fn demo_writes_tables_and_plots() {
     let dir = tempfile::tempdir().unwrap();
@@ -267,8 +268,21 @@ fn demo_writes_tables_and_plots() {
     let f = dir.path().join("facade");
     let s: Value = serde_json::from_str(&std::fs::read_to_string(f.join("summary.json")).unwrap()).unwrap();
     let rows = s["ensemble"]["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 3 * 2 * 3, "records × polarities × sets");
-    for set in ["housner", "calibrated", "campaign"] {
+    let mut sets = vec!["housner", "calibrated", "campaign"];
+    for (c, law, constant) in [
+        ("one-sided-demo", "campaign law", "campaign constant"),
+        ("mujoco-public-one-sided", "mujoco law", "mujoco constant"),
+    ] {
+        let summary: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join(c).join("summary.json")).unwrap()).unwrap();
+        let fitted = &summary["restitution_law"];
+        assert!(fitted.is_object(), "{c}: no law");
+        sets.push(law);
+        if fitted["form"] != "constant" {
+            sets.push(constant);
+        }
+    }
+    assert_eq!(rows.len(), 3 * 2 * sets.len(), "records × polarities × sets");
+    for &set in &sets {
         assert!(rows.iter().any(|r| r["coefficients"] == set), "{set}");
         assert!(stdout.contains(&format!("| {set} | **")), "{set} row in {stdout}");
     }
@@ -278,7 +292,7 @@ fn demo_writes_tables_and_plots() {
         assert!(ci[0].as_f64().unwrap() <= p && p <= ci[1].as_f64().unwrap());
     }
     let fits = s["fragility"]["sets"].as_array().unwrap();
-    assert_eq!(fits.len(), 3);
+    assert_eq!(fits.len(), sets.len());
     for f in fits {
         assert!(f["fit"].get("median").is_some() || f["fit"].get("error").is_some(), "{f}");
     }
@@ -852,4 +866,48 @@ fn report_html_says_each_suspect_reason_once() {
     assert!(html.contains("id=\"quality-s1000\"") && html.contains("href=\"#plots-s1000\""));
     // The CSV keeps the whole reason.
     assert!(std::fs::read_to_string(out.join("table1.csv")).unwrap().contains(&reasons[0]));
+
+/// Issue 20: a coefficient set may be a restitution law (`law = FILE`, a
+/// summary.json's `restitution_law` or the law alone): the study runs it and says
+/// so; its errors name the set, the key, or the law file with line and column.
+#[test]
+fn facade_law_set() {
+    let dir = tempfile::tempdir().unwrap();
+    let law = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/law.json");
+    let law_text = std::fs::read_to_string(&law).unwrap();
+    // A summary-shaped file: the law under "restitution_law", beside other keys.
+    std::fs::write(
+        dir.path().join("summary.json"),
+        format!("{{\"campaign\": \"x\", \"restitution_law\": {law_text}}}"),
+    )
+    .unwrap();
+    let with_set = |set: &str| SMALL_STUDY.to_string() + "\n[[coefficients]]\nname = \"law\"\n" + set + "\n";
+    let study = write_study(dir.path(), &with_set(&format!("law = \"{}\"", law.display())));
+    let out = dir.path().join("out");
+    let o = facade(&study, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = s["runs"].as_array().unwrap();
+    assert!(runs.iter().any(|r| r["coefficients"] == "law"));
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(md.contains("the law's e at a = 1"), "{md}");
+    let study = write_study(dir.path(), &with_set("law = \"summary.json\"\ne_h = 0.98\nspread = \"none\""));
+    let o = facade(&study, &dir.path().join("o2"), &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::write(dir.path().join("bad.json"), "{\n  \"form\": \"speed-loss\",\n  \"parameters\": 3\n}\n").unwrap();
+    std::fs::write(dir.path().join("none.json"), "{\"campaign\": \"x\"}").unwrap();
+    for (set, expect) in [
+        ("law = \"summary.json\"\ne_in = 0.5", "law = FILE takes no e"),
+        ("law = \"summary.json\"\nspread = \"tests\"", "spread = \"tests\": a law set takes"),
+        ("law = \"summary.json\"\ne_h = 1.5", "e_h = 1.5"),
+        ("e = 0.9\ne_h = 0.98", "e_h is for a set with a law"),
+        ("law = \"missing.json\"", "not found"),
+        ("law = \"bad.json\"", "bad.json:3"),
+        ("law = \"none.json\"", "no restitution_law"),
+    ] {
+        let study = write_study(dir.path(), &with_set(set));
+        let o = facade(&study, &dir.path().join("o3"), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
+    }
 }

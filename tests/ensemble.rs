@@ -35,6 +35,7 @@ fn rectangular_pulse_probability_matches_the_draws_above_housner_threshold() {
         ties: Vec::new(),
         e_in: 0.9,
         e_out: 0.9,
+        law: None,
         overturn_limit: alpha,
         linearized: true,
     };
@@ -135,6 +136,7 @@ fn early_stop_at_rest_changes_no_result() {
                     let spec = RunSpec {
                         e_in: set.e_in,
                         e_out: set.e_out,
+                        law: None,
                         scale,
                         polarity: pol,
                         overturn_limit: 0.1,
@@ -163,4 +165,109 @@ fn early_stop_at_rest_changes_no_result() {
         }
     }
     assert!(rested > 0, "no run came to rest: the early stop was not exercised");
+}
+
+/// Issue 20: an illustrative law for the tests (fixtures/facade/law.json, written
+/// by hand in the shape the issue describes: inward constant 0.62, outward
+/// r = 1.0 − 0.05/√(a(2 − a)), from 0.65 at a = 0.01 to 0.95 at a = 1).
+fn fixture_law() -> rocklab::restitution_law::RestitutionLaw {
+    rocklab::ingest::law::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/law.json")).unwrap()
+}
+
+/// Issue 20: a set with a constant law (r_in, r_out) and a given e_H runs exactly as
+/// the pair (r_in e_H, r_out e_H): the nominal runs and every sample of the
+/// ensembles (common random numbers: the sets differ only in how e is given) have
+/// the same outcome and peak, bit for bit.
+#[test]
+fn a_constant_law_set_runs_as_its_pair() {
+    use rocklab::facade::{run_study, CoefficientSet};
+    use rocklab::restitution_law::RestitutionLaw;
+    let mut study = fixture_study();
+    study.records.truncate(1);
+    let (r_in, r_out, e_h) = (0.61, 0.7, 0.98);
+    let alpha = study.block.block.alpha;
+    let law = CoefficientSet::law(
+        "law",
+        RestitutionLaw::constant(r_in, 0.0, r_out, 0.0),
+        Some(e_h),
+        alpha,
+        true,
+        "test".into(),
+    );
+    let pair = CoefficientSet {
+        name: "pair".into(),
+        e_in: r_in * e_h,
+        e_out: r_out * e_h,
+        source: "test".into(),
+        dist: CoefficientDist::Pair {
+            e_in: Dist::Fixed { value: r_in * e_h },
+            e_out: Dist::Fixed { value: r_out * e_h },
+        },
+    };
+    assert_eq!((law.e_in, law.e_out), (pair.e_in, pair.e_out));
+    study.sets = vec![pair, law];
+    let runs = run_study(&study, 1.0, false, &|| {}).unwrap();
+    let key = |r: &rocklab::facade::StudyRun| {
+        (
+            r.summary.max_theta_over_alpha.to_bits(),
+            r.summary.overturned,
+            r.summary.impacts,
+            r.summary.steps,
+        )
+    };
+    // Runs are record-major, then set, then polarity: the pair's two polarities, then the law's.
+    assert_eq!(runs.len(), 4);
+    for k in 0..2 {
+        assert_eq!(key(&runs[k]), key(&runs[k + 2]), "{} {}", runs[k].record, runs[k].polarity);
+    }
+    let (rows, samples) = run_ensembles(&study, 3, &|| {}).unwrap();
+    for p in rows.chunks(2) {
+        assert_eq!(p[0].stats, p[1].stats);
+    }
+    let n_impacts: usize = runs.iter().map(|r| r.summary.impacts).sum();
+    assert!(n_impacts > 0, "no impacts: nothing compared");
+    for p in samples.chunks(3).collect::<Vec<_>>().chunks(2) {
+        for (a, b) in p[0].iter().zip(p[1]) {
+            assert_eq!(a.outcome, b.outcome);
+            assert_eq!((a.inputs.magnification, a.inputs.alpha), (b.inputs.magnification, b.inputs.alpha));
+        }
+    }
+}
+
+/// Issue 20: a law set's draws are pure functions of the sample's key, differ from
+/// sample to sample when the law has a covariance, keep the nominal law when
+/// `drawn` is off, and apply e_H by Eq. 2 with the sample's α when none is given.
+#[test]
+fn law_draws_follow_the_seed_and_the_sample() {
+    use rocklab::wall::{housner_e, Side};
+    let law = fixture_law();
+    let nominal = Nominal {
+        magnification: 1.27,
+        r_m: 3.84,
+        alpha: 0.1,
+        i0: 2.6e6,
+        spring_bed: None,
+    };
+    let unc = Uncertainty {
+        alpha_rad: Some(Dist::Uniform { lo: 0.1, hi: 0.1044 }),
+        ..Default::default()
+    };
+    let key = |sample: u64| SampleKey {
+        seed: 2021,
+        record: name_key("r"),
+        row: 1,
+        scale: 0,
+        sample,
+    };
+    let set = |drawn: bool| CoefficientDist::Law { law, e_housner: None, drawn };
+    assert!(set(true).is_random() && !set(false).is_random());
+    let a = draw(&key(1), &unc, &nominal, "law", &set(true), Some(1.0));
+    assert_eq!(a, draw(&key(1), &unc, &nominal, "law", &set(true), Some(1.0)));
+    let b = draw(&key(2), &unc, &nominal, "law", &set(true), Some(1.0));
+    let (la, eh) = a.law.unwrap();
+    assert_eq!(eh, housner_e(a.alpha));
+    assert_ne!(la.r(Side::Outward, 0.5), b.law.unwrap().0.r(Side::Outward, 0.5));
+    assert_eq!(a.e_out, la.e(Side::Outward, 1.0, eh));
+    let c = draw(&key(1), &unc, &nominal, "law", &set(false), Some(1.0));
+    assert_eq!(c.law.unwrap().0, law);
 }

@@ -342,6 +342,7 @@ fn spec() -> RunSpec {
     RunSpec {
         e_in: 0.9,
         e_out: 0.9,
+        law: None,
         scale: 1.0,
         polarity: 1.0,
         overturn_limit: 0.1,

@@ -96,8 +96,8 @@ fn reduce_test_ids_stay_inside_out() {
     let logs: Vec<String> = (0..NAMES.len()).map(|i| format!("log{i}.csv")).collect();
     files.extend(logs.iter().map(|l| (l.as_str(), log.clone())));
     let out = stays_inside(&files, &["reduce", "campaign.toml", "--out", "OUT"]);
+    // Four plots per test, and the campaign's restitution law (issue 20) as PNG and SVG.
     let plots = out.iter().filter(|p| p.starts_with("plots")).count();
-    // Four per test, and the campaign's restitution-law plot (PNG and SVG, issue 20).
     assert_eq!(plots, 4 * NAMES.len() + 2, "{out:?}");
 }
 

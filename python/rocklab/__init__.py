@@ -6,7 +6,8 @@ Rust library code as the ``rocklab`` command line:
 
 - :func:`reduce` (``rocklab reduce``), :func:`reduce_log` (one test given as arrays),
 - :func:`simulate` (``rocklab simulate``), :func:`calibrate` (``rocklab calibrate``),
-- :func:`facade` (``rocklab facade``) and :func:`facade_runs` (any selection of a
+- :func:`facade` (``rocklab facade``), :func:`facade_ensembles` (its uncertainty
+  ensembles and fragility curves) and :func:`facade_runs` (any selection of a
   study's runs; :mod:`rocklab.dask` spreads them over a Dask cluster).
 
 Each result's ``summary`` is exactly the JSON document the CLI writes as
@@ -47,6 +48,7 @@ __all__ = [
     "SimulationResult",
     "CalibrationResult",
     "FacadeResult",
+    "EnsembleResult",
     "reduce",
     "reduce_log",
     "impacts",
@@ -55,6 +57,7 @@ __all__ = [
     "calibrate",
     "facade",
     "facade_runs",
+    "facade_ensembles",
     "plan_facade",
     "study_info",
     "parse_scales",
@@ -366,6 +369,8 @@ def simulate(
     rtol: float = 1e-8,
     atol: float = 1e-10,
     history: bool = True,
+    law: Union[None, PathLike, Mapping] = None,
+    e_h: Optional[float] = None,
 ) -> SimulationResult:
     """Rocking response of a block to a record, as ``rocklab simulate``.
 
@@ -380,7 +385,15 @@ def simulate(
         e or e_in/e_out or calibration: coefficients of restitution (default: the
             block's ``[impact]``).
         history: return the time history (False saves memory in large batches).
+        law: a restitution law instead of e: a summary.json written by ``reduce``
+            (its ``restitution_law``), a law file, or the law as a dict (``{"form",
+            "parameters"}``, or a summary dict holding ``restitution_law``). At each
+            impact e = min(1, r(side, a)·e_H), a the apex |θ|/α of the half-cycle
+            that ends; ``summary["law"]`` holds it, and ``e_in``/``e_out`` are then
+            the law's e at a = 1.
+        e_h: the e_H a law's r is multiplied by (default: Eq. 2 with the block's α).
     """
+    law_path, law_json = _law_args(law)
     block_path, block_json = _block_args(block)
     record_path, acc, rec_dt, rec_units = _record_args(record)
     text, raw = _rocklab.simulate(
@@ -402,8 +415,22 @@ def simulate(
         rtol=float(rtol),
         atol=float(atol),
         history=history,
+        law_path=law_path,
+        law_json=law_json,
+        e_h=e_h,
     )
     return SimulationResult(json.loads(text), _arrays(raw) if history else {})
+
+
+def _law_args(law) -> tuple:
+    if law is None:
+        return None, None
+    if isinstance(law, (str, os.PathLike)):
+        return os.fspath(law), None
+    if isinstance(law, Mapping):
+        law = law.get("restitution_law", law)
+        return None, json.dumps(law)
+    raise RocklabError("law: expected a summary.json or law file path, or the law as a dict")
 
 
 # ---------------------------------------------------------------------------
@@ -488,6 +515,68 @@ def facade(study: PathLike, *, scales: Union[None, str, Sequence[float]] = None)
     summary = doc["summary"]
     ida = _frame(doc["ida"]) if doc["ida"] is not None else None
     return FacadeResult(summary, _frame(_run_rows(summary["runs"])), ida)
+
+
+@dataclass
+class EnsembleResult:
+    """The façade's ensembles and fragility, as ``rocklab facade`` computes them.
+
+    Attributes:
+        rows: one row per record × polarity row × coefficient set (samples,
+            overturned, p_overturn with its 95 % Wilson interval, verdict, max θ/α
+            median and 5–95 %, median overturning time): the CLI's ``ensemble.csv``.
+        samples: one row per sample (its drawn inputs and outcome); for a law set
+            ``e_in``/``e_out`` are the drawn law's e at a = 1.
+        fragility: one row per set (``median``, ``beta`` and their intervals, or
+            ``error`` when no fit is possible), or None when there is nothing to fit.
+        fragility_source: "ida" (fitted to the IDA's samples) or "ensemble".
+        doc: the whole document.
+    """
+
+    rows: Any
+    samples: Any
+    fragility: Any
+    fragility_source: Optional[str]
+    doc: dict
+
+
+def facade_ensembles(
+    study: PathLike,
+    *,
+    samples: Optional[int] = None,
+    seed: Optional[int] = None,
+    scales: Union[None, str, Sequence[float]] = None,
+    ida_samples: Optional[int] = None,
+) -> EnsembleResult:
+    """The uncertainty ensembles and fragility curves of a façade study (what
+    :func:`facade` leaves out), with the same numbers as the CLI for the same seed.
+
+    ``samples``, ``seed`` and ``ida_samples`` override the study's; ``scales``
+    ("FROM:TO:N" or factors) fits the fragility to an IDA with ``ida_samples``
+    samples per point, else to the ensemble (two records or more). A coefficient
+    set with a restitution law (``law = FILE`` in the study) draws its parameters
+    from their covariance in each sample.
+    """
+    doc = json.loads(
+        _rocklab.facade_ensembles(
+            os.fspath(study),
+            None if samples is None else int(samples),
+            None if seed is None else int(seed),
+            _scales(scales),
+            None if ida_samples is None else int(ida_samples),
+        )
+    )
+    frag = doc["fragility"]
+    fits = None
+    if frag is not None:
+        fits = _frame([dict(coefficients=s["coefficients"], **s["fit"]) for s in frag["sets"]])
+    return EnsembleResult(
+        rows=_frame(_scalar_columns(doc["rows"])),
+        samples=_frame(_scalar_columns(doc["samples"])),
+        fragility=fits,
+        fragility_source=None if frag is None else frag["source"],
+        doc=doc,
+    )
 
 
 def _run_rows(runs: list) -> list:

@@ -18,15 +18,18 @@ use pyo3::types::{PyBytes, PyDict};
 use rayon::prelude::*;
 use serde_json::{json, Value};
 
-use rocklab::facade::{run_ida, run_study, Study};
+use rocklab::facade::{fragility_by_set, run_ensembles, run_ida, run_ida_samples, run_study, Study};
 use rocklab::ground_motion::{Format, ReadOptions, Record, Units};
 use rocklab::ingest::block::BlockSpec;
 use rocklab::ingest::{Campaign, LogData};
 use rocklab::peaks::{Method, PeakOptions};
 use rocklab::reduce::{campaign_result, reduce_campaign, reduce_loaded, CampaignResult};
 use rocklab::report::{docs, summary::summary, tables};
+use rocklab::restitution_law::RestitutionLaw;
 use rocklab::signal::savgol::SavGol;
+use rocklab::solver::block::ImpactDefaults;
 use rocklab::study::{run, RunSpec};
+use rocklab::wall::Side;
 
 pyo3::create_exception!(
     _rocklab,
@@ -258,7 +261,7 @@ fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
 #[pyfunction]
 #[pyo3(signature = (block_path=None, block_json=None, record_path=None, acc=None, format=None, dt=None, units=None,
                     scale=1.0, polarity=1, e=None, e_in=None, e_out=None, calibration=None, overturn_limit=None,
-                    t_extra=0.0, rtol=1e-8, atol=1e-10, history=true))]
+                    t_extra=0.0, rtol=1e-8, atol=1e-10, history=true, law_path=None, law_json=None, e_h=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -280,23 +283,22 @@ fn simulate<'py>(
     rtol: f64,
     atol: f64,
     history: bool,
+    law_path: Option<PathBuf>,
+    law_json: Option<String>,
+    e_h: Option<f64>,
 ) -> PyResult<(String, Bound<'py, PyDict>)> {
     let acc = acc.map(|a| a.to_vec());
     let (doc, s) = guarded(py, move || {
         let block = load_block(block_path, block_json)?;
         let (record_name, record) = load_record(record_path, acc, format, dt, units)?;
         let d = block.impact;
-        let (e_in, e_out) = match (calibration, e, e_in, e_out) {
-            (Some(file), None, None, None) => rocklab::ingest::calibration::read_coefficients(&file)?,
-            (Some(_), ..) => bail!("give calibration, or e, or e_in with e_out: not several"),
-            (None, Some(e), None, None) => (e, e),
-            (None, None, Some(i), Some(o)) => (i, o),
-            (None, None, None, None) => match (d.e, d.e_in, d.e_out) {
-                (Some(e), _, _) => (e, e),
-                (None, Some(i), Some(o)) => (i, o),
-                _ => bail!("no coefficient of restitution: pass e=E, e_in=X with e_out=Y or calibration=FILE (or set [impact] in the block)"),
-            },
-            _ => bail!("pass e=E, or both e_in and e_out"),
+        let law = load_law(law_path, law_json, e_h, block.block.alpha)?;
+        if law.is_some() && (calibration.is_some() || e.is_some() || e_in.is_some() || e_out.is_some()) {
+            bail!("give a law, or e, or e_in with e_out, or calibration: not several");
+        }
+        let (e_in, e_out) = match (law, calibration, e, e_in, e_out) {
+            (Some((l, e_h)), ..) => (l.e(Side::Inward, 1.0, e_h), l.e(Side::Outward, 1.0, e_h)),
+            (None, calibration, e, e_in, e_out) => simulate_pair(&d, calibration, e, e_in, e_out)?,
         };
         let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
         if polarity != 1 && polarity != -1 {
@@ -308,6 +310,7 @@ fn simulate<'py>(
         let spec = RunSpec {
             e_in,
             e_out,
+            law,
             scale,
             polarity: polarity as f64,
             overturn_limit: overturn_limit.or(d.overturn_limit_rad).unwrap_or(block.block.alpha),
@@ -317,7 +320,11 @@ fn simulate<'py>(
             keep_history: history,
         };
         let (summary, sim) = run(&block, &record, &spec)?;
-        let doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
+        let mut doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
+        if let Some((l, e_h)) = law {
+            // e_in and e_out of the document are then the law's e at a = 1.
+            doc["law"] = json!({"law": l, "e_housner": e_h});
+        }
         let alpha = block.block.alpha;
         let h = &sim.history;
         let series: Series = vec![
@@ -330,6 +337,51 @@ fn simulate<'py>(
         Ok((doc, series))
     })?;
     to_python(py, doc, s)
+}
+
+/// A restitution law for `simulate`: a law file (summary.json or the law alone) or
+/// the law's JSON, with e_H as given or by Eq. 2 with the block's α.
+fn load_law(path: Option<PathBuf>, json_text: Option<String>, e_h: Option<f64>, alpha: f64) -> anyhow::Result<Option<(RestitutionLaw, f64)>> {
+    let law = match (path, json_text) {
+        (Some(p), None) => rocklab::ingest::law::read(&p)?,
+        (None, Some(t)) => serde_json::from_str::<RestitutionLaw>(&t).context("law")?,
+        (None, None) => {
+            if let Some(e) = e_h {
+                bail!("e_h = {e}: e_h is for a law");
+            }
+            return Ok(None);
+        }
+        (Some(_), Some(_)) => bail!("give the law as a file or as a dict, not both"),
+    };
+    let e_h = match e_h {
+        Some(e) if e > 0.0 && e <= 1.0 => e,
+        Some(e) => bail!("e_h = {e}: expected 0 < e_H ≤ 1"),
+        None => rocklab::wall::housner_e(alpha),
+    };
+    Ok(Some((law, e_h)))
+}
+
+/// The constant pair of `simulate`: a calibration, e, e_in with e_out, or the
+/// block's `[impact]`.
+fn simulate_pair(
+    d: &ImpactDefaults,
+    calibration: Option<PathBuf>,
+    e: Option<f64>,
+    e_in: Option<f64>,
+    e_out: Option<f64>,
+) -> anyhow::Result<(f64, f64)> {
+    Ok(match (calibration, e, e_in, e_out) {
+        (Some(file), None, None, None) => rocklab::ingest::calibration::read_coefficients(&file)?,
+        (Some(_), ..) => bail!("give calibration, or e, or e_in with e_out: not several"),
+        (None, Some(e), None, None) => (e, e),
+        (None, None, Some(i), Some(o)) => (i, o),
+        (None, None, None, None) => match (d.e, d.e_in, d.e_out) {
+            (Some(e), _, _) => (e, e),
+            (None, Some(i), Some(o)) => (i, o),
+            _ => bail!("no coefficient of restitution: pass e=E, e_in=X with e_out=Y or calibration=FILE (or set [impact] in the block)"),
+        },
+        _ => bail!("pass e=E, or both e_in and e_out"),
+    })
 }
 
 /// `rocklab calibrate MANIFEST` without writing files: the summary.json it writes
@@ -364,6 +416,51 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
         let wall = start.elapsed().as_secs_f64();
         let ida = scales.map(|sc| run_ida(&study, &sc, &|| {})).transpose()?;
         Ok(json!({"summary": docs::facade_summary(&study, &runs, wall, None, None)?, "ida": ida}))
+    })?;
+    Ok(doc.to_string())
+}
+
+/// The façade's ensembles and fragility, as `rocklab facade` computes them
+/// (without the nominal runs): the ensemble rows and samples at scale 1 (when the
+/// study has samples), and a lognormal fragility per set fitted to the IDA's
+/// samples (with `scales`) or to the ensemble's (≥ 2 records), as the CLI does.
+/// `samples`, `seed` and `ida_samples` override the study's.
+#[pyfunction]
+#[pyo3(signature = (study, samples=None, seed=None, scales=None, ida_samples=None))]
+fn facade_ensembles(
+    py: Python<'_>,
+    study: PathBuf,
+    samples: Option<usize>,
+    seed: Option<u64>,
+    scales: Option<Vec<f64>>,
+    ida_samples: Option<usize>,
+) -> PyResult<String> {
+    let doc = guarded(py, move || {
+        let mut study = Study::load(&study)?;
+        study.samples = samples.unwrap_or(study.samples);
+        study.seed = seed.unwrap_or(study.seed);
+        study.ida_samples = ida_samples.unwrap_or(study.ida_samples).max(1);
+        let (rows, ens) = if study.samples > 0 {
+            run_ensembles(&study, study.samples, &|| {})?
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let fragility = match &scales {
+            Some(sc) => {
+                let ida = run_ida_samples(&study, sc, study.ida_samples, &|| {})?;
+                Some(json!({"source": "ida", "scales": sc, "sets": fragility_by_set(&study, &ida), "samples": ida}))
+            }
+            None if !ens.is_empty() && study.records.len() >= 2 => Some(json!({"source": "ensemble", "sets": fragility_by_set(&study, &ens)})),
+            None => None,
+        };
+        Ok(json!({
+            "samples_per_row": study.samples,
+            "seed": study.seed,
+            "ida_samples": study.ida_samples,
+            "rows": rows,
+            "samples": ens,
+            "fragility": fragility,
+        }))
     })?;
     Ok(doc.to_string())
 }
@@ -472,6 +569,7 @@ fn _rocklab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parse_scales, m)?)?;
     m.add_function(wrap_pyfunction!(study_info, m)?)?;
     m.add_function(wrap_pyfunction!(facade_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(facade_ensembles, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

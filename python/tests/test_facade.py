@@ -36,9 +36,9 @@ def test_facade_equals_cli_summary_and_ida(cli, tmp_path):
     expected = json.loads((tmp_path / "summary.json").read_text())
     res = rocklab.facade(STUDY, scales="0.5:1.5:3")
     assert _runs_without_timing(res.summary["runs"]) == _runs_without_timing(expected["runs"])
-    # The binding runs the nominal study and the IDA; the CLI's summary also holds
-    # the ensembles and fragility fits of issue #10, which the binding does not
-    # expose yet (README, "what is next").
+    # facade runs the nominal study and the IDA; the CLI's summary also holds the
+    # ensembles and fragility fits of issue #10, which facade_ensembles gives
+    # (test_facade_law.py compares them with the CLI's).
     drop = {"runs", TIMING, "ensemble", "fragility"}
     assert {k: v for k, v in res.summary.items() if k not in drop} == {k: v for k, v in expected.items() if k not in drop}
     ida = rocklab.read_csv(tmp_path / "ida.csv")

@@ -1,5 +1,8 @@
 //! `rocklab demo`: reduce and calibrate the fixture campaigns and run the façade
-//! study, into `reports/demo/`.
+//! study, into `reports/demo/`. The façade study gets, beside its constant
+//! sets, the restitution laws of the one-sided campaigns (reduce → law in
+//! summary.json → façade): the demo's own and the engine-made one with compliant
+//! contacts (`mujoco-public-one-sided`), whose coefficient falls with amplitude.
 
 use std::process::ExitCode;
 
@@ -29,6 +32,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     let cal = rocklab::ingest::calibration::read(&cal_path)?.calibration;
     let set = rocklab::facade::calibration_set("campaign", &cal_path.display().to_string(), &cal, "tests").map_err(|e| anyhow::anyhow!(e))?;
     study.sets.push(set);
+    ok &= reduce_for_law(&args, "mujoco-public-one-sided")?;
+    for (campaign, name) in [("one-sided-demo", "campaign"), ("mujoco-public-one-sided", "mujoco")] {
+        study.sets.extend(law_sets(&args, &study, campaign, name)?);
+    }
     let scales = rocklab::facade::parse_scales(&args.scales)?;
     say(&format!(
         "façade study: {} ({} samples per record × polarity × set, seed {}; fragility from {} scales × {} samples)",
@@ -40,4 +47,59 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     ));
     super::facade::run_and_write(&study, Some(&scales), &args.out.join("facade"))?;
     Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Reduce a campaign only for its law: its reduce outputs into `out/NAME`.
+fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
+    let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
+    let campaign = Campaign::load(&manifest)?;
+    let sources = super::load::campaign_sources(&campaign);
+    let res = reduce_and_print(campaign, PeakOptions::default());
+    let files = rocklab::report::reduce_files(&res, &sources, true, &rocklab::report::Extras::default())?;
+    rocklab::report::write_files(&args.out.join(name), &files)?;
+    say("");
+    let ok = res.failed().next().is_none();
+    Ok(ok)
+}
+
+/// The law sets of `campaign` from the summary.json the demo wrote for it: "NAME
+/// law" (the fitted law) and "NAME constant" (the best constant pair of the same
+/// impacts, `restitution_law.constant`, as a constant law), both as r × e_H by
+/// Eq. 2 with the façade's α and drawn from their covariance, so that the two
+/// differ only in the law's form (the constant set is left out when the fitted
+/// law is itself the constant: the data did not reject it). None, said on the
+/// terminal, when the summary holds no law.
+fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Vec<rocklab::facade::CoefficientSet>> {
+    use rocklab::facade::CoefficientSet;
+    use rocklab::restitution_law::RestitutionLaw;
+    let path = args.out.join(campaign).join("summary.json");
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)?;
+    let Some(fitted) = doc.get("restitution_law") else {
+        say(&format!(
+            "{}: no restitution_law, so the façade study has no \"{name} law\" set",
+            path.display()
+        ));
+        return Ok(Vec::new());
+    };
+    let alpha = study.block.block.alpha;
+    let law = rocklab::ingest::law::read(&path)?;
+    let mut sets = vec![CoefficientSet::law(
+        &format!("{name} law"),
+        law,
+        None,
+        alpha,
+        true,
+        format!("law {} ({})", path.display(), law.form.as_str()),
+    )];
+    let c = &fitted["constant"];
+    let num = |k: &str| {
+        c[k].as_f64()
+            .ok_or_else(|| anyhow::anyhow!("{}: restitution_law.constant.{k}: expected a number", path.display()))
+    };
+    if law.form != rocklab::restitution_law::LawForm::Constant {
+        let constant = RestitutionLaw::constant(num("r_in")?, num("r_in_u")?, num("r_out")?, num("r_out_u")?);
+        let source = format!("the constant pair of {}", path.display());
+        sets.push(CoefficientSet::law(&format!("{name} constant"), constant, None, alpha, true, source));
+    }
+    Ok(sets)
 }

@@ -133,6 +133,7 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
     Ok(RunSpec {
         e_in,
         e_out,
+        law: None,
         scale: a.scale,
         polarity: a.polarity as f64,
         overturn_limit,

@@ -98,7 +98,14 @@ struct RawSet {
     sd_e_out: Option<f64>,
     /// With a calibration: "tests" (default: the test-to-test spread and the
     /// fits' standard errors), "mean" (the standard error of the mean) or "none".
+    /// With a law: "fit" (default: the parameters' covariance) or "none".
     spread: Option<String>,
+    /// A restitution law: a summary.json written by `rocklab reduce` (its
+    /// `restitution_law`) or a JSON file holding the law itself.
+    law: Option<String>,
+    /// e_H the law's r is multiplied by (default: Eq. 2 with the block's α, and
+    /// with each sample's α in the ensembles).
+    e_h: Option<f64>,
 }
 
 /// One distribution of `[uncertainty]`: a number (fixed), `{ normal = [mean, sd] }`
@@ -240,6 +247,12 @@ fn set_dist(path: &Path, s: &RawSet, e_in: f64, e_out: f64, single: bool) -> Res
 /// One `[[coefficients]]` set: given, Housner's Eq. 2 with the block's α, or a
 /// calibration file.
 fn coefficient_set(path: &Path, base: &Path, s: &RawSet, alpha: f64) -> Result<CoefficientSet> {
+    if let Some(file) = s.law.as_deref() {
+        return law_set(path, base, s, file, alpha);
+    }
+    if s.e_h.is_some() {
+        return Err(bad(path, format!("[[coefficients]] {:?}: e_h is for a set with a law", s.name)));
+    }
     if s.spread.is_some() && s.calibration.is_none() {
         return Err(bad(
             path,
@@ -273,6 +286,40 @@ fn coefficient_set(path: &Path, base: &Path, s: &RawSet, alpha: f64) -> Result<C
         source,
         dist,
     })
+}
+
+/// A set with a restitution law read from `file` (a summary.json's
+/// `restitution_law`, or the law alone), applied with e_H = `e_h` or Eq. 2.
+fn law_set(path: &Path, base: &Path, s: &RawSet, file: &str, alpha: f64) -> Result<CoefficientSet> {
+    let named = |msg: String| bad(path, format!("[[coefficients]] {:?}: {msg}", s.name));
+    let others = [
+        s.e.is_some(),
+        s.e_in.is_some(),
+        s.e_out.is_some(),
+        s.housner.is_some(),
+        s.calibration.is_some(),
+    ];
+    if others.iter().any(|x| *x) || s.sd_e.or(s.sd_e_in).or(s.sd_e_out).is_some() {
+        return Err(named(
+            "law = FILE takes no e, e_in, e_out, housner, calibration or sd_e* (its spread is the law's covariance: spread = \"fit\" or \"none\")"
+                .into(),
+        ));
+    }
+    let drawn = match s.spread.as_deref() {
+        None | Some("fit") => true,
+        Some("none") => false,
+        Some(o) => return Err(named(format!("spread = {o:?}: a law set takes \"fit\" or \"none\""))),
+    };
+    if let Some(e_h) = s.e_h.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
+        return Err(named(format!("e_h = {e_h}: expected 0 < e_H ≤ 1")));
+    }
+    let law = crate::ingest::law::read(&base.join(file))?;
+    let e_h = match s.e_h {
+        Some(e) => format!("e_H = {e}"),
+        None => "e_H by Eq. 2".to_string(),
+    };
+    let source = format!("law {file} ({}), {e_h}", law.form.as_str());
+    Ok(CoefficientSet::law(&s.name, law, s.e_h, alpha, drawn, source))
 }
 
 /// A set read from a calibration file, with the spread it asks for.

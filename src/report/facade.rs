@@ -186,8 +186,13 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
         .sets
         .iter()
         .map(|s| {
+            let law = if s.law_at(study.block.block.alpha).is_some() {
+                ", the law's e at a = 1"
+            } else {
+                ""
+            };
             format!(
-                "{} (e_in {}, e_out {}, {})",
+                "{} (e_in {}, e_out {}{law}, {})",
                 s.name,
                 crate::ensemble::short(s.e_in),
                 crate::ensemble::short(s.e_out),
@@ -474,6 +479,17 @@ fn describe_set(s: &CoefficientSet) -> String {
     match s.dist {
         CoefficientDist::Single(d) => format!("(e {}, {})", d.describe(), s.source),
         CoefficientDist::Pair { e_in, e_out } => format!("(e_in {}, e_out {}, {})", e_in.describe(), e_out.describe(), s.source),
+        CoefficientDist::Law { drawn, .. } => format!(
+            "(law, {}; e at a = 1: in {}, out {}; {})",
+            if drawn {
+                "parameters drawn from their covariance"
+            } else {
+                "nominal parameters"
+            },
+            crate::ensemble::short(s.e_in),
+            crate::ensemble::short(s.e_out),
+            s.source
+        ),
     }
 }
 

@@ -15,6 +15,7 @@
 //! - Ground acceleration ü_g: record × magnification × polarity, linear between
 //!   samples.
 
+use super::impact::ImpactLaw;
 use crate::wall::Side;
 use crate::G;
 
@@ -106,6 +107,9 @@ pub struct RockingModel {
     /// Coefficient applied when entering the inward side (θ' < 0 at θ = 0).
     pub e_in: f64,
     pub e_out: f64,
+    /// A restitution law applied instead of (e_in, e_out): e = r(side, a)·e_H with
+    /// a the apex |θ|/α of the half-cycle that ends ([`super::impact`]).
+    pub law: Option<ImpactLaw>,
     /// Overturning limit on |θ| (rad): outward always; inward when unrestrained.
     pub overturn_limit: f64,
     /// Use sin x ≈ x, cos x ≈ 1 (the linearised equation; for verification).
@@ -146,6 +150,18 @@ impl RockingModel {
                 f * tie.height_m * ct
             })
             .sum()
+    }
+
+    /// The coefficient of an impact entering `entering` that ends a half-cycle of
+    /// apex |θ| = `apex` (rad): the law's min(1, r(side, apex/α)·e_H), else e_in
+    /// or e_out.
+    #[inline]
+    pub fn coefficient(&self, entering: Side, apex: f64) -> f64 {
+        match (&self.law, entering) {
+            (Some(law), _) => law.e(entering, apex / self.alpha),
+            (None, Side::Inward) => self.e_in,
+            (None, Side::Outward) => self.e_out,
+        }
     }
 
     /// Update the plastic elongations after an accepted step at rotation θ.

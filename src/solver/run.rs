@@ -1,7 +1,8 @@
 //! The event-driven rocking loop: integrate on the current pivot, locate impacts
 //! and overturning on the dense output, apply θ' ← e θ' at impacts, go to rest when
 //! the impacts have taken the speed below a threshold, and uplift again when
-//! |ü_g| > g tan α. The loop returns why it stopped.
+//! |ü_g| > g tan α. The loop returns why it stopped. It tracks the apex max |θ| of
+//! each half-cycle, at which a restitution law is read at the impact that ends it.
 
 use super::integrator::{find_root, next_h, step, Dense, State, Tolerances};
 use super::model::{Ground, RockingModel};
@@ -305,6 +306,8 @@ struct Loop<'a, 'o> {
     threshold: f64,
     /// After this time |ü_g| ≤ threshold everywhere (found on the first rest).
     quiet: Option<f64>,
+    /// max |θ| since the last impact or uplift: the apex of the current half-cycle.
+    apex: f64,
 }
 
 impl<'a, 'o> Loop<'a, 'o> {
@@ -335,6 +338,7 @@ impl<'a, 'o> Loop<'a, 'o> {
             h: 1e-3f64.min(settings.max_step),
             threshold: model.uplift_threshold(),
             quiet: None,
+            apex: 0.0,
         };
         run.push(t0, run.y);
         run
@@ -342,6 +346,7 @@ impl<'a, 'o> Loop<'a, 'o> {
 
     /// Record a point: the extremes, and the history when kept.
     fn push(&mut self, t: f64, y: State) {
+        self.apex = self.apex.max(y[0].abs());
         self.sim.max_theta = self.sim.max_theta.max(y[0]);
         self.sim.min_theta = self.sim.min_theta.min(y[0]);
         if self.settings.keep_history {
@@ -385,6 +390,7 @@ impl<'a, 'o> Loop<'a, 'o> {
                 }
                 self.t = tu;
                 self.sim.events.push(Event::Uplift { t: tu, side });
+                self.apex = 0.0;
                 self.phase = Phase::Rocking(side);
                 self.k1 = None;
                 StepOutcome::Uplift
@@ -435,7 +441,9 @@ impl<'a, 'o> Loop<'a, 'o> {
             self.h = 0.25 * hh;
             return StepOutcome::Rejected;
         }
-        track_extremum(&mut self.sim, &st.dense, t, hh, &y, &st.y1);
+        if let Some(th) = track_extremum(&mut self.sim, &st.dense, t, hh, &y, &st.y1) {
+            self.apex = self.apex.max(th.abs());
+        }
         let dense = &st.dense;
         self.out.fill(ev.map_or(t + hh, |e| e.0), |x| dense.at(x)[0]);
         match ev {
@@ -465,14 +473,12 @@ impl<'a, 'o> Loop<'a, 'o> {
     }
 
     /// An impact at `te` with θ' = `vb` coming from pivot `from`: θ' ← e θ' with
-    /// the coefficient of the side entered; rest when that leaves the wall slower
-    /// than the rest speed.
+    /// the coefficient of the side entered (a law's at the apex of the half-cycle
+    /// that ends); rest when that leaves the wall slower than the rest speed.
     fn impact(&mut self, from: Side, te: f64, vb: f64, hh: f64) {
         let entering = from.opposite();
-        let e = match entering {
-            Side::Inward => self.model.e_in,
-            Side::Outward => self.model.e_out,
-        };
+        let e = self.model.coefficient(entering, self.apex);
+        self.apex = 0.0;
         let va = e * vb;
         self.push(te, [0.0, vb]);
         self.sim.impacts += 1;
@@ -546,14 +552,16 @@ fn first_event(model: &RockingModel, side: Side, d: &Dense, t: f64, h: f64, y0: 
     None
 }
 
-/// Record θ at a turning point inside the step (θ' changes sign).
-fn track_extremum(sim: &mut Simulation, d: &Dense, t: f64, h: f64, y0: &State, y1: &State) {
+/// Record θ at a turning point inside the step (θ' changes sign), and return it.
+fn track_extremum(sim: &mut Simulation, d: &Dense, t: f64, h: f64, y0: &State, y1: &State) -> Option<f64> {
     if y0[1] * y1[1] < 0.0 {
         let te = find_root(|x| d.at(x)[1], t, t + h, 1e-12);
         let th = d.at(te)[0];
         sim.max_theta = sim.max_theta.max(th);
         sim.min_theta = sim.min_theta.min(th);
+        return Some(th);
     }
+    None
 }
 
 /// The first record sample strictly after t (or +∞ past the record).

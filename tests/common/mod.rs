@@ -53,6 +53,7 @@ pub fn synthetic_log(s: &LogSpec) -> (String, Vec<f64>) {
         ties: Vec::new(),
         e_in: s.e_in,
         e_out: s.e_out,
+        law: None,
         overturn_limit: 1.0,
         linearized: false,
     };

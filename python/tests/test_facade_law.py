@@ -1,0 +1,71 @@
+"""Issue 20: simulate with a restitution law, and the façade's ensembles and
+fragility from Python, against the CLI."""
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+import rocklab
+from conftest import BLOCK, FIXTURES, NRC_1030, STUDY, run_cli
+
+LAW = FIXTURES / "facade" / "law.json"
+
+
+def _constant_law(r_in, r_out):
+    side = lambda r: {"r_inf": r, "c": 0.0, "cov": [[0.0, 0.0], [0.0, 0.0]]}
+    return {
+        "form": "constant",
+        "parameters": {"in": side(r_in), "out": side(r_out), "shared": False, "amplitude_min": 1e-6, "amplitude_max": 1.0},
+    }
+
+
+def test_constant_law_is_the_pair_bit_for_bit():
+    """A constant law (r_in, r_out) with e_H gives the history of the pair
+    (r_in e_H, r_out e_H), bit for bit."""
+    r_in, r_out, e_h = 0.61, 0.7, 0.98
+    law = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=_constant_law(r_in, r_out), e_h=e_h)
+    pair = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, e_in=r_in * e_h, e_out=r_out * e_h)
+    assert law["impacts"] > 5
+    for k in ("t_s", "theta_rad", "theta_dot_rad_s"):
+        np.testing.assert_array_equal(law.history[k], pair.history[k])
+    assert law["law"]["e_housner"] == e_h
+    # A summary dict holding the law is accepted as well.
+    wrapped = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law={"restitution_law": _constant_law(r_in, r_out)}, e_h=e_h, history=False)
+    assert (wrapped["impacts"], wrapped["max_theta_over_alpha"]) == (law["impacts"], law["max_theta_over_alpha"])
+
+
+def test_law_file_and_errors():
+    res = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=LAW, history=False)
+    alpha = res["alpha_rad"]
+    assert res["law"]["e_housner"] == pytest.approx(1 - 1.5 * np.sin(alpha) ** 2, abs=1e-15)
+    assert res["law"]["law"]["form"] == "speed-loss"
+    with pytest.raises(rocklab.RocklabError, match="not several"):
+        rocklab.simulate(BLOCK, NRC_1030, law=LAW, e=0.9)
+    with pytest.raises(rocklab.RocklabError, match="e_h = 1.5"):
+        rocklab.simulate(BLOCK, NRC_1030, law=LAW, e_h=1.5)
+    with pytest.raises(rocklab.RocklabError, match="law"):
+        rocklab.simulate(BLOCK, NRC_1030, law={"form": "speed-loss"})
+
+
+def test_facade_ensembles_equal_cli(cli, tmp_path):
+    """The ensembles and fragility fits equal the CLI's for the same seed, with a
+    law set in the study (its parameters drawn in each sample)."""
+    study_dir = tmp_path / "study"
+    shutil.copytree(FIXTURES / "facade", study_dir)
+    text = STUDY.read_text().replace("../ground-motions", str(FIXTURES / "ground-motions"))
+    text += '\n[[coefficients]]\nname = "law"\nlaw = "law.json"\n'
+    study = study_dir / "study.toml"
+    study.write_text(text)
+    out = tmp_path / "out"
+    run_cli(cli, "facade", study, "--out", out, "--samples", "4", "--seed", "7", "--scales", "0.5:1.5:3", "--ida-samples", "2")
+    expected = json.loads((out / "summary.json").read_text())
+    res = rocklab.facade_ensembles(study, samples=4, seed=7, scales="0.5:1.5:3", ida_samples=2)
+    assert res.doc["rows"] == expected["ensemble"]["rows"]
+    assert [s["fit"] for s in res.doc["fragility"]["sets"]] == [s["fit"] for s in expected["fragility"]["sets"]]
+    assert res.fragility_source == "ida"
+    assert list(res.fragility["coefficients"]) == ["housner", "calibrated", "law"]
+    assert len(res.rows) == 3 * 2 * 3 and len(res.samples) == 3 * 2 * 3 * 4
+    law_samples = res.samples[res.samples["coefficients"] == "law"]
+    assert law_samples["e_out"].nunique() > 1, "the law's parameters are drawn per sample"

@@ -866,6 +866,7 @@ fn report_html_says_each_suspect_reason_once() {
     assert!(html.contains("id=\"quality-s1000\"") && html.contains("href=\"#plots-s1000\""));
     // The CSV keeps the whole reason.
     assert!(std::fs::read_to_string(out.join("table1.csv")).unwrap().contains(&reasons[0]));
+}
 
 /// Issue 20: a coefficient set may be a restitution law (`law = FILE`, a
 /// summary.json's `restitution_law` or the law alone): the study runs it and says

@@ -127,7 +127,11 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 /// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
 pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
     let warnings = log.warnings.clone();
-    let result = crate::reduction::reduce_log(log, &physics(campaign, spec), campaign.e_housner, options).map_err(|source| TestError::Reduce {
+    let options = PeakOptions {
+        acquisition: spec.acquisition,
+        ..*options
+    };
+    let result = crate::reduction::reduce_log(log, &physics(campaign, spec), campaign.e_housner, &options).map_err(|source| TestError::Reduce {
         file: spec.file.clone(),
         source,
     });

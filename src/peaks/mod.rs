@@ -70,6 +70,7 @@
 //! No crate does this: it is a domain-specific piecewise model fit; the
 //! Levenberg–Marquardt loop is [`crate::fit`], the linear algebra nalgebra's.
 
+pub mod acquisition;
 pub mod checks;
 mod crossings;
 pub mod model;
@@ -121,6 +122,8 @@ pub struct PeakOptions {
     pub method: Method,
     /// Which impact model the default estimator takes.
     pub contacts: ContactModel,
+    /// The data logger's filter, as the manifest states it ([`acquisition`]).
+    pub acquisition: acquisition::Acquisition,
 }
 
 impl Default for PeakOptions {
@@ -129,6 +132,7 @@ impl Default for PeakOptions {
             n_peaks: 6,
             method: Method::Segments,
             contacts: ContactModel::FromLog,
+            acquisition: acquisition::Acquisition::Unknown,
         }
     }
 }
@@ -226,6 +230,9 @@ pub struct Analysis {
     /// The second estimate of each peak: a local fit of the end of its arc
     /// (velocity, standard uncertainty), where the arc has enough samples.
     pub local_peaks: Vec<Option<(f64, f64)>>,
+    /// The logger's filter the model was seen through, and its source
+    /// ([`acquisition`]).
+    pub response: acquisition::ResponseUsed,
 }
 
 /// What the plausibility checks say of an analysis: `Ok`, or `Suspect` with the
@@ -255,7 +262,7 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
     let prepared = prepare_log(t, x, opts.n_peaks)?;
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
-        Method::Segments => by_segments(t, prepared, phys, opts.n_peaks, opts.contacts),
+        Method::Segments => by_segments(t, prepared, phys, opts),
     }
 }
 
@@ -341,13 +348,19 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         contact_phases: false,
         gamma_fit: None,
         local_peaks: Vec::new(),
+        response: acquisition::ResponseUsed {
+            source: "not modelled (Savitzky–Golay)",
+            filter: None,
+        },
     }
 }
 
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
-fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts: ContactModel) -> Result<Analysis, PeakError> {
+fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
+    let n_peaks = opts.n_peaks;
+    let (filter, response) = acquisition::stated(&opts.acquisition);
     let fit = SegmentFit::run(&FitInput {
         t,
         x: &p.x,
@@ -357,7 +370,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         crossings: &p.crossings,
         phys,
         n_peaks,
-        contacts,
+        contacts: opts.contacts,
+        filter,
     })?;
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);
@@ -404,5 +418,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         contact_phases: fit.contacts,
         gamma_fit: fit.model().gamma(),
         local_peaks: local,
+        response,
     })
 }

@@ -56,6 +56,8 @@ pub struct FitInput<'a> {
     pub phys: &'a Physics,
     pub n_peaks: usize,
     pub contacts: ContactModel,
+    /// The logger's filter, where stated ([`super::acquisition`]).
+    pub filter: Option<std::sync::Arc<super::acquisition::ModelFilter>>,
 }
 
 impl SegmentFit {
@@ -286,6 +288,7 @@ fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: b
         min_len: 0.5 * dt,
         lever,
         q,
+        filter: inp.filter.clone(),
     }
 }
 

@@ -30,8 +30,8 @@ use std::sync::Arc;
 
 use nalgebra::Complex;
 
-use super::model::Model;
-use crate::signal::filter::{hermite_cubic, LowPass, Modal, StepCoefficients};
+use super::model::{fit_model, Fitted, Model};
+use crate::signal::filter::{hermite_cubic, Family, LowPass, Modal, StepCoefficients};
 
 /// What the manifest says of the logger's filter (SPEC, `[acquisition]`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -226,4 +226,164 @@ pub fn through_filter(model: &Model, filter: &ModelFilter, t: &[f64]) -> Vec<Opt
         }
     }
     out
+}
+
+/// The generic low-pass an unstated filter is estimated as: Bessel, order 4.
+pub const GENERIC: (Family, usize) = (Family::Bessel, 4);
+/// The range of cut-offs searched, as fractions of the sampling rate: from
+/// below the lowest setting of the draws (0.1 f_s) to where a Bessel filter
+/// delays a sample by less than half a sample (0.7 f_s: no longer visible).
+const SEARCH: (f64, f64) = (0.07, 0.7);
+
+/// An unstated filter's estimate: the fit through it, the low-pass and how
+/// well the data pin its cut-off.
+#[derive(Debug, Clone)]
+pub struct Estimate {
+    pub fitted: Fitted,
+    pub lowpass: LowPass,
+    /// Cost decrease over the unfiltered fit, in units of σ².
+    pub gain: f64,
+    /// Standard uncertainty of ln f_c from the cost's curvature (2σ² / cost''),
+    /// None where the cost is flat.
+    pub u_ln_fc: Option<f64>,
+}
+
+/// Fit `start` seen through the generic low-pass at `fc` (Hz).
+fn fit_through(start: &Model, fc: f64, tw: &[f64], yw: &[f64], iters: usize) -> Option<Fitted> {
+    let lp = LowPass {
+        family: GENERIC.0,
+        order: GENERIC.1,
+        cutoff_hz: fc,
+    };
+    let mut m = start.clone();
+    m.filter = Some(ModelFilter::new(lp.modal()));
+    fit_model(m, tw, yw, iters)
+}
+
+/// Estimate an unstated causal low-pass: the cut-off that minimises the fit's
+/// cost, by golden-section search on ln f_c over [0.07, 0.7] f_s (each point a
+/// fit of every model parameter, warm-started from the best so far), then a
+/// parabola through the three best points for its curvature. `plain` is the
+/// unfiltered fit.
+pub fn estimate(plain: &Fitted, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Option<Estimate> {
+    let fs = 1.0 / dt;
+    let sigma2 = sigma.powi(2).max(1e-12);
+    let mut seen: Vec<(f64, f64)> = Vec::new();
+    let mut best: Option<(f64, Fitted)> = None;
+    let eval = |x: f64, best: &mut Option<(f64, Fitted)>, seen: &mut Vec<(f64, f64)>| -> f64 {
+        let start = best.as_ref().map_or(&plain.model, |b| &b.1.model);
+        let cost = match fit_through(start, fs * x.exp(), tw, yw, 40) {
+            Some(f) => {
+                let c = f.fit.cost;
+                if best.as_ref().is_none_or(|b| c < b.1.fit.cost) {
+                    *best = Some((x, f));
+                }
+                c
+            }
+            None => f64::INFINITY,
+        };
+        seen.push((x, cost));
+        cost
+    };
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (SEARCH.0.ln(), SEARCH.1.ln());
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let mut fc_ = eval(c, &mut best, &mut seen);
+    let mut fd = eval(d, &mut best, &mut seen);
+    while b - a > 0.03 {
+        if fc_ < fd {
+            b = d;
+            d = c;
+            fd = fc_;
+            c = b - g * (b - a);
+            fc_ = eval(c, &mut best, &mut seen);
+        } else {
+            a = c;
+            c = d;
+            fc_ = fd;
+            d = a + g * (b - a);
+            fd = eval(d, &mut best, &mut seen);
+        }
+    }
+    let (x, fitted) = best?;
+    // A final polish at the best cut-off.
+    let fitted = fit_through(&fitted.model, fs * x.exp(), tw, yw, 60).filter(|f| f.fit.cost <= fitted.fit.cost).unwrap_or(fitted);
+    let u_ln_fc = curvature_u(&seen, sigma2);
+    Some(Estimate {
+        gain: (plain.fit.cost - fitted.fit.cost) / sigma2,
+        lowpass: LowPass {
+            family: GENERIC.0,
+            order: GENERIC.1,
+            cutoff_hz: fs * x.exp(),
+        },
+        fitted,
+        u_ln_fc,
+    })
+}
+
+/// σ of the minimiser of a least-squares cost sampled at (x, cost): the
+/// parabola through the three lowest points, u² = 2σ²/cost''.
+fn curvature_u(seen: &[(f64, f64)], sigma2: f64) -> Option<f64> {
+    let mut pts: Vec<(f64, f64)> = seen.iter().copied().filter(|p| p.1.is_finite()).collect();
+    pts.sort_by(|p, q| p.1.total_cmp(&q.1));
+    let [(x0, y0), (x1, y1), (x2, y2)] = pts.get(..3)?.try_into().ok()?;
+    let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
+    if d.abs() < 1e-300 {
+        return None;
+    }
+    let curv = 2.0 * (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
+    (curv > 0.0).then(|| (2.0 * sigma2 / curv).sqrt())
+}
+
+/// Where the plain fit misses the samples around its impacts and no filter is
+/// stated: estimate one ([`estimate`]) and keep it where the data ask for it
+/// and it explains them better than the model chosen without it (`chosen`,
+/// plain or with contact phases, whose extra parameters cost `penalty` σ²):
+/// the Bayesian information criterion, cost/σ² + k ln n with k = 1 for the
+/// cut-off; and not at either end of the searched range.
+/// Compliant contacts also round the kinks, but each by its own contact and
+/// before θ = 0 as well, where a causal filter rounds every kink alike and only
+/// after it: on the MuJoCo campaigns the contact phases win. Returns the
+/// estimate and the peaks of the fits at f_c e^(±u) (their spread is a term of u).
+pub fn rival(plain: &Fitted, chosen: &Fitted, penalty: f64, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Option<(Estimate, Vec<Vec<f64>>)> {
+    let est = estimate(plain, tw, yw, dt, sigma)?;
+    let (n, sigma2) = (tw.len() as f64, sigma.powi(2).max(1e-12));
+    // At either end of the range the cost has no minimum inside it: not a
+    // filter's signature (at the top none is visible; at the bottom the
+    // rounding is wider than any setting of a logger's displacement channel:
+    // a compliant contact's, the one-sided MuJoCo test P1_90_1).
+    let x = est.lowpass.cutoff_hz * dt;
+    let at_end = x > 0.95 * SEARCH.1 || x < 1.05 * SEARCH.0;
+    let bic_filter = est.fitted.fit.cost / sigma2 + n.ln();
+    let bic_chosen = chosen.fit.cost / sigma2 + penalty;
+    if est.gain <= n.ln() || at_end || bic_filter >= bic_chosen {
+        return None;
+    }
+    let m = plain.model.m();
+    let u = est.u_ln_fc.unwrap_or(0.5).min(0.5);
+    let spread: Vec<Vec<f64>> = [-u, u]
+        .iter()
+        .filter_map(|d| fit_through(&est.fitted.model, est.lowpass.cutoff_hz * d.exp(), tw, yw, 40))
+        .map(|f| (0..m).map(|k| f.model.peak(k).1).collect())
+        .collect();
+    Some((est, spread))
+}
+
+/// The estimated cut-off's share of the peaks' covariance: with v± the peaks of
+/// the fits at f_c e^(±u), d = (v₊ − v₋)/2 is one standard uncertainty of every
+/// peak from one cause (fully correlated): Σ += d dᵀ.
+pub(super) fn add_cutoff_spread(cov: &mut [Vec<f64>], spread: &[Vec<f64>]) {
+    let [lo, hi] = spread else { return };
+    let d: Vec<f64> = (0..cov.len())
+        .map(|k| match (lo.get(k), hi.get(k)) {
+            (Some(a), Some(b)) if (b - a).is_finite() => 0.5 * (b - a),
+            _ => 0.0,
+        })
+        .collect();
+    for (a, row) in cov.iter_mut().enumerate() {
+        for (b, c) in row.iter_mut().enumerate() {
+            *c += d[a] * d[b];
+        }
+    }
 }

@@ -360,7 +360,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
 /// checks ([`quality`]).
 fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
     let n_peaks = opts.n_peaks;
-    let (filter, response) = acquisition::stated(&opts.acquisition);
+    let (filter, mut response) = acquisition::stated(&opts.acquisition);
     let fit = SegmentFit::run(&FitInput {
         t,
         x: &p.x,
@@ -372,7 +372,14 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         n_peaks,
         contacts: opts.contacts,
         filter,
+        estimate_filter: opts.acquisition == acquisition::Acquisition::Unknown,
     })?;
+    if let Some((est, _)) = &fit.estimated {
+        response = acquisition::ResponseUsed {
+            source: "estimated",
+            filter: Some(est.lowpass),
+        };
+    }
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);
     let impacts = fit.impacts();
@@ -387,6 +394,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
+        if let Some((_, cutoff)) = &fit.estimated {
+            acquisition::add_cutoff_spread(&mut c, cutoff);
+        }
         c
     });
     let peaks: Vec<Peak> = impacts

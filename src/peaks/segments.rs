@@ -43,6 +43,9 @@ pub struct SegmentFit {
     /// The peaks of the instantaneous-impact model where contact phases were
     /// chosen (the model-form spread).
     pub alternative: Option<Vec<f64>>,
+    /// An unstated filter found and estimated, and the peaks of the fits at its
+    /// cut-off ± one standard uncertainty (the spread carried into u).
+    pub estimated: Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>,
 }
 
 /// Inputs of the fit.
@@ -58,6 +61,8 @@ pub struct FitInput<'a> {
     pub contacts: ContactModel,
     /// The logger's filter, where stated ([`super::acquisition`]).
     pub filter: Option<std::sync::Arc<super::acquisition::ModelFilter>>,
+    /// No filter stated: look for one ([`super::acquisition::estimate`]).
+    pub estimate_filter: bool,
 }
 
 impl SegmentFit {
@@ -97,7 +102,8 @@ impl SegmentFit {
         // the noise the two extra fits would only cost time (3× on a
         // 2,000,000-row log).
         let expected = inp.contacts == ContactModel::Expected;
-        let windows: &[f64] = if expected || misses_around_impacts(&simple.model, &tw, &yw, dt, inp.sigma) {
+        let misses = misses_around_impacts(&simple.model, &tw, &yw, dt, inp.sigma);
+        let windows: &[f64] = if expected || misses {
             &[2.0 * dt, 0.01f64.max(2.0 * dt)]
         } else {
             &[]
@@ -124,7 +130,20 @@ impl SegmentFit {
         // the model-form spread. (Where they were not, the contact fit's are not
         // used: on the idealised draw that raised the median stated u of a
         // table value from 0.27 to 0.34 pp, against a median error of 0.02 pp.)
-        let alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
+        let mut alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
+        // No filter stated: a low-pass rounds the kinks too, and is kept where it
+        // explains them better than contact phases ([`super::acquisition::rival`]).
+        let estimated = (inp.estimate_filter && misses)
+            .then(|| {
+                let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
+                super::acquisition::rival(&simple, &chosen, penalty, &tw, &yw, dt, inp.sigma)
+            })
+            .flatten();
+        if let Some((e, _)) = &estimated {
+            chosen = e.fitted.clone();
+            contacts = false;
+            alternative = None;
+        }
         Ok(SegmentFit {
             rms: (chosen.fit.cost / n).sqrt(),
             fitted: chosen,
@@ -135,6 +154,7 @@ impl SegmentFit {
             contacts,
             outliers,
             alternative,
+            estimated,
         })
     }
 

@@ -37,6 +37,9 @@ struct Reduction<'a> {
     u: Option<Uncertainties<'a>>,
     release_time_s: f64,
     impacts: &'a [Impact],
+    /// The logger's filter the model was seen through: stated, estimated, or
+    /// none (issue #18).
+    acquisition: &'a crate::peaks::acquisition::ResponseUsed,
 }
 
 /// One entry of `"tests"`.
@@ -66,6 +69,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 u: r.uncertainty.as_ref().map(Uncertainties),
                 release_time_s: r.analysis.release_time_s,
                 impacts: &r.analysis.impacts,
+                acquisition: &r.analysis.response,
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }

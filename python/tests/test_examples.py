@@ -1,4 +1,4 @@
-"""The README's Python snippet and the example notebook run as shown."""
+"""The Python snippets of README.md and docs/python.md, and the example notebook run as shown."""
 
 import os
 import re
@@ -10,16 +10,27 @@ import pytest
 from conftest import ROOT
 
 
+def python_snippets(path, heading=None):
+    """The ```python blocks of a Markdown file, or of its section under `heading`."""
+    text = (ROOT / path).read_text()
+    if heading is not None:
+        start = text.index(heading)
+        end = text.find("\n## ", start + 1)
+        text = text[start : end if end >= 0 else len(text)]
+    return re.findall(r"```python\n(.*?)```", text, re.S)
+
+
 def test_readme_python_snippets_run(monkeypatch, capsys):
-    """Both snippets of the README's Python section (the API, then Dask), as a user
-    pastes them into a script run from the repository root."""
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Python") : text.index("\n## ", text.index("## Python") + 1)]
-    snippets = re.findall(r"```python\n(.*?)```", section, re.S)
-    assert len(snippets) == 2
+    """The Python snippets of README.md and docs/python.md, and both of docs/python.md (the API, then Dask), as a
+    user pastes them into a script run from the repository root."""
+    readme = python_snippets("README.md", "## Python")
+    docs = python_snippets("docs/python.md")
+    assert len(readme) == 1 and len(docs) == 2
     monkeypatch.chdir(ROOT)
-    for i, snippet in enumerate(snippets):
-        exec(compile(snippet, f"README.md (Python snippet {i + 1})", "exec"), {"__name__": "__main__"})
+    for name, snippets in [("README.md", readme), ("docs/python.md", docs)]:
+        for i, snippet in enumerate(snippets):
+            code = compile(snippet, f"{name} (Python snippet {i + 1})", "exec")
+            exec(code, {"__name__": "__main__"})
     printed = capsys.readouterr().out
     assert "150_1" in printed and "max θ/α" in printed
     assert "overturned" in printed and "max_theta_over_alpha" in printed

@@ -682,7 +682,11 @@ fn fir_taps(fc: f64, n: usize) -> Vec<f64> {
         .map(|i| {
             let m = i as f64 - mid;
             let x = 2.0 * fc * m;
-            let sinc = if x.abs() < 1e-12 { 1.0 } else { (std::f64::consts::PI * x).sin() / (std::f64::consts::PI * x) };
+            let sinc = if x.abs() < 1e-12 {
+                1.0
+            } else {
+                (std::f64::consts::PI * x).sin() / (std::f64::consts::PI * x)
+            };
             let w = 0.54 - 0.46 * (2.0 * std::f64::consts::PI * i as f64 / (n as f64 - 1.0)).cos();
             2.0 * fc * sinc * w
         })
@@ -766,4 +770,3 @@ pub fn draw_logged(seed: u64, family: Family, kind: LoggerDraw) -> (Synthetic, L
     };
     (generate_logged(&spec, logger), logger)
 }
-

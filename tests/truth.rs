@@ -16,10 +16,16 @@ const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", 
 /// A fixture campaign; with `unstated`, its manifest without the lines that
 /// state the logger's filter (the lab that does not know it: issue #18).
 fn load_campaign(name: &str, unstated: bool) -> Campaign {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name).join("campaign.toml");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/campaigns")
+        .join(name)
+        .join("campaign.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let text: String = if unstated {
-        text.lines().filter(|l| !l.trim_start().starts_with("acquisition")).map(|l| format!("{l}\n")).collect()
+        text.lines()
+            .filter(|l| !l.trim_start().starts_with("acquisition"))
+            .map(|l| format!("{l}\n"))
+            .collect()
     } else {
         text
     };
@@ -350,7 +356,11 @@ fn accuracy_table() {
         ("daq-public-fir-2", false),
     ];
     for (name, unstated) in names {
-        let shown = if unstated { format!("{name} (filter not stated)") } else { name.to_string() };
+        let shown = if unstated {
+            format!("{name} (filter not stated)")
+        } else {
+            name.to_string()
+        };
         for (label, method) in [
             ("rocklab (default)", Method::Segments),
             ("Savitzky–Golay 11/3 + peaks", Method::SavGol(SavGol::new(11, 3).unwrap())),

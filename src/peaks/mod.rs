@@ -351,6 +351,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         response: acquisition::ResponseUsed {
             source: "not modelled (Savitzky–Golay)",
             filter: None,
+            fir_cutoff_hz: None,
         },
     }
 }
@@ -375,10 +376,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         estimate_filter: opts.acquisition == acquisition::Acquisition::Unknown,
     })?;
     if let Some((est, _)) = &fit.estimated {
-        response = acquisition::ResponseUsed {
-            source: "estimated",
-            filter: Some(est.lowpass),
-        };
+        response = est.used();
     }
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);
@@ -394,8 +392,11 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
-        if let Some((_, cutoff)) = &fit.estimated {
+        if let Some((est, cutoff)) = &fit.estimated {
             acquisition::add_cutoff_spread(&mut c, cutoff);
+            if let Some((_, other)) = &est.runner_up {
+                uncertainty::add_model_spread(&mut c, &impacts, other);
+            }
         }
         c
     });
@@ -411,6 +412,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         .collect();
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
     let verdict = quality::plausibility(&fit, &peaks, &local, &spread, p.dt, p.sigma);
+    let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,

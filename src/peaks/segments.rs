@@ -103,11 +103,7 @@ impl SegmentFit {
         // 2,000,000-row log).
         let expected = inp.contacts == ContactModel::Expected;
         let misses = misses_around_impacts(&simple.model, &tw, &yw, dt, inp.sigma);
-        let windows: &[f64] = if expected || misses {
-            &[2.0 * dt, 0.01f64.max(2.0 * dt)]
-        } else {
-            &[]
-        };
+        let windows: &[f64] = if expected || misses { &[2.0 * dt, 0.01f64.max(2.0 * dt)] } else { &[] };
         for &window in windows {
             let Some(c) = fit_model(simple.model.with_contacts(window), &tw, &yw, 100) else {
                 continue;
@@ -131,18 +127,11 @@ impl SegmentFit {
         // used: on the idealised draw that raised the median stated u of a
         // table value from 0.27 to 0.34 pp, against a median error of 0.02 pp.)
         let mut alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
-        // No filter stated: a low-pass rounds the kinks too, and is kept where it
-        // explains them better than contact phases ([`super::acquisition::rival`]).
-        let estimated = (inp.estimate_filter && misses)
-            .then(|| {
-                let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
-                super::acquisition::rival(&simple, &chosen, penalty, &tw, &yw, dt, inp.sigma)
-            })
-            .flatten();
+        // No filter stated: a low-pass rounds the kinks too.
+        let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
+        let estimated = rival_filter(inp.estimate_filter && misses, &simple, &chosen, penalty, &tw, &yw, inp.sigma);
         if let Some((e, _)) = &estimated {
-            chosen = e.fitted.clone();
-            contacts = false;
-            alternative = None;
+            (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
         }
         Ok(SegmentFit {
             rms: (chosen.fit.cost / n).sqrt(),
@@ -216,6 +205,15 @@ impl SegmentFit {
         self.model().residuals(&self.tw, &self.yw, &mut r);
         r
     }
+}
+
+/// Where `look` (no filter stated, the plain fit misses the samples around its
+/// impacts): an estimated low-pass, if it beats `chosen` ([`super::acquisition::rival`]).
+type Rival = Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>;
+fn rival_filter(look: bool, plain: &Fitted, chosen: &Fitted, penalty: f64, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
+    let dt = (tw[tw.len() - 1] - tw[0]) / (tw.len() - 1) as f64;
+    look.then(|| super::acquisition::rival(plain, chosen, penalty, tw, yw, dt, sigma))
+        .flatten()
 }
 
 /// Isolated spikes the spike filter missed: a spike next to an impact, where the

@@ -42,7 +42,7 @@ use std::sync::Arc;
 
 use nalgebra::Complex;
 
-use super::model::{fit_model, Fitted, Model};
+use super::model::{fit_model, Fitted, Instrument, Model};
 use crate::signal::filter::{hermite_cubic, Family, Fir, LowPass, Modal, StepCoefficients};
 
 /// What the manifest says of the logger's filter (SPEC, `[acquisition]`).
@@ -99,6 +99,15 @@ pub enum Response {
     Fir(Fir),
 }
 
+impl Instrument for ModelFilter {
+    fn seen(&self, model: &Model, t: &[f64]) -> Vec<Option<f64>> {
+        through_filter(model, self, t)
+    }
+    fn delay(&self) -> f64 {
+        self.delay
+    }
+}
+
 impl ModelFilter {
     pub fn new(modal: Modal) -> Arc<ModelFilter> {
         let delay = modal.group_delay();
@@ -116,10 +125,10 @@ impl ModelFilter {
 }
 
 /// The filter a stated acquisition puts in the model, and how the report names it.
-pub fn stated(acq: &Acquisition) -> (Option<Arc<ModelFilter>>, ResponseUsed) {
+pub fn stated(acq: &Acquisition) -> (Option<Arc<dyn Instrument>>, ResponseUsed) {
     match acq {
         Acquisition::Stated(lp) => (
-            Some(ModelFilter::new(lp.modal())),
+            Some(ModelFilter::new(lp.modal()) as Arc<dyn Instrument>),
             ResponseUsed {
                 source: "stated",
                 filter: Some(*lp),
@@ -365,7 +374,7 @@ impl Generic {
         }
     }
     /// The model filter at `fc` (Hz) for the sampling interval `dt`.
-    fn filter(self, fc: f64, dt: f64) -> Arc<ModelFilter> {
+    fn filter(self, fc: f64, dt: f64) -> Arc<dyn Instrument> {
         match self {
             Generic::Bessel4 | Generic::Butterworth4 => ModelFilter::new(self.lowpass(fc).modal()),
             Generic::Fir64 => ModelFilter::fir(Fir::new(fc, 64, dt)),

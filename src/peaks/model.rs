@@ -126,7 +126,16 @@ pub struct Model {
     /// The data logger's filter the samples went through, where stated or
     /// estimated: the residuals then compare the samples with the model seen
     /// through it ([`super::acquisition`]).
-    pub filter: Option<std::sync::Arc<super::acquisition::ModelFilter>>,
+    pub filter: Option<std::sync::Arc<dyn Instrument>>,
+}
+
+/// What the samples went through before they were logged (the data logger's
+/// filter, implemented in `acquisition.rs`): the model as the logger would have
+/// recorded it at the samples `t` (None where the model is undefined), and how
+/// late a smooth arc comes out of it (s).
+pub trait Instrument: std::fmt::Debug + Send + Sync {
+    fn seen(&self, model: &Model, t: &[f64]) -> Vec<Option<f64>>;
+    fn delay(&self) -> f64;
 }
 
 /// Where the gravity term is linearised on an arc of apex θ_m (θ* = β θ_m) when
@@ -423,7 +432,7 @@ impl Model {
             return false;
         }
         if let Some(f) = &self.filter {
-            let seen = super::acquisition::through_filter(self, f, t);
+            let seen = f.seen(self, t);
             out.extend(seen.into_iter().zip(y).map(|(m, yi)| m.map_or(0.0, |m| yi - m)));
             return true;
         }

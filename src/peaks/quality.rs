@@ -20,7 +20,7 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
             let lambda = if inward_spring { m.lambda().unwrap_or(0.0) } else { -m.p().powi(2) };
             // Through a causal filter the arc's samples come out late by its
             // group delay (the samples before the kink do not see it yet).
-            let late = m.filter.as_ref().map_or(0.0, |f| f.delay);
+            let late = m.filter.as_ref().map_or(0.0, |f| f.delay());
             let (slope, u) = checks::local_slope(&fit.tw[i0..i1], &fit.yw[i0..i1], end + late, lambda, sigma)?;
             Some((slope, u))
         })

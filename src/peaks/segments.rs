@@ -60,7 +60,7 @@ pub struct FitInput<'a> {
     pub n_peaks: usize,
     pub contacts: ContactModel,
     /// The logger's filter, where stated ([`super::acquisition`]).
-    pub filter: Option<std::sync::Arc<super::acquisition::ModelFilter>>,
+    pub filter: Option<std::sync::Arc<dyn super::model::Instrument>>,
     /// No filter stated: look for one ([`super::acquisition::estimate`]).
     pub estimate_filter: bool,
 }

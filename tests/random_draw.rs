@@ -226,20 +226,34 @@ fn unstated_fir_full_draw() {
     assert!(rate >= 0.98, "success rate {rate}");
 }
 
-/// Both causal families, order 2–8, over the whole range 0.10–0.45 f_s,
-/// stated and not: none ok and more than 2 pp off; the rates are printed
-/// (docs/acquisition.md).
-#[test]
-#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
-fn causal_families_full_draw() {
-    let all = LoggerDraw::Causal {
+fn all_causal() -> LoggerDraw {
+    LoggerDraw::Causal {
         family: None,
         lo: 0.10,
         hi: 0.45,
-    };
-    let (_, off_stated) = summarise_logged("stated causal", &run_logged(5000..5200, all, true));
-    let (_, off_unstated) = summarise_logged("unstated causal", &run_logged(6000..6200, all, false));
-    assert_eq!(off_stated + off_unstated, 0);
+    }
+}
+
+/// Both causal families (Bessel, Butterworth), order 2–8, over 0.10–0.45 f_s,
+/// stated: measured 99.0 % ok within 1 pp, none ok and more than 2 pp off.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn stated_causal_families_full_draw() {
+    let (rate, off) = summarise_logged("stated causal", &run_logged(5000..5200, all_causal(), true));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
+}
+
+/// The same, not stated: measured 98.5 % ok within 1 pp, and ONE test ok but
+/// 2.33 pp off (draw 6122, a Butterworth of order 8 at 0.32 f_s, 100 Hz, read
+/// as a Bessel 4 with no runner-up close enough to flag it). A known gap
+/// (docs/acquisition.md): this test fails until it is closed.
+#[test]
+#[ignore = "known gap, fails on one test (docs/acquisition.md): run in release"]
+fn unstated_causal_families_full_draw() {
+    let (rate, off) = summarise_logged("unstated causal", &run_logged(6000..6200, all_causal(), false));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
 }
 
 /// The unstated-FIR draws that were ok but 1.0–1.9 pp off before the FIR was

@@ -21,9 +21,11 @@
 //!
 //! # A linear-phase FIR
 //! A delta-sigma converter's FIR ([`Fir`]) is not causal about its centre; it
-//! is modelled by its kink responses: r_i = y + (m₂/2) y″ + Σ_k Δv_k C₁(t_i − t_k)
-//! + Δa_k G₂(t_i − t_k), the jumps Δv, Δa of slope and curvature at every
-//! kink from one-sided differences of the model's exact slope (`kink_jumps`;
+//! is modelled by its kink responses,
+//!
+//!   r_i = y + (m₂/2) y″ + Σ_k [Δv_k C₁(t_i − t_k) + Δa_k G₂(t_i − t_k)],
+//!
+//! the jumps Δv, Δa of slope and curvature at every kink from one-sided differences of the model's exact slope (`kink_jumps`;
 //! the last impact, with no arc after it, takes the jumps of the impact two
 //! before it scaled by its arrival speed). Its delay of half its length shifts
 //! every time alike and is absorbed by the model's times.

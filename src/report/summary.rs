@@ -127,5 +127,5 @@ pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
         mean_included: &res.means.included,
         mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
     };
-    Ok(serde_json::to_value(doc)?)
+    super::json_value(&doc)
 }

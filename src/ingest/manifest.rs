@@ -292,7 +292,10 @@ fn parse_acquisition(path: &Path, where_: &str, a: &RawAcquisition) -> Result<Ac
             format!("{where_}cutoff_hz is missing: a {} filter needs its −3 dB frequency", a.filter),
         )
     })?;
-    let cutoff_hz = positive(path, &format!("{where_}cutoff_hz"), cutoff_hz)?;
+    // A cut-off within the range of a logger's rate (1 Hz – 1 MHz: limits.rs).
+    let cutoff_hz = crate::limits::LOG_RATE_HZ
+        .check(&format!("{where_}cutoff_hz"), cutoff_hz)
+        .map_err(|m| bad(path, m))?;
     Ok(Acquisition::Stated(LowPass {
         family,
         order: order as usize,
@@ -602,7 +605,7 @@ time = { column = "t_ms", unit = "ms" }
             (
                 "cutoff_hz = 50.0",
                 "cutoff_hz = -5.0",
-                "m.toml:25:1: [acquisition].cutoff_hz = -5: expected a positive number",
+                "m.toml:25:1: [acquisition].cutoff_hz = -5: expected a value",
             ),
             ("order = 4\n", "", "[acquisition].order is missing"),
             ("cutoff_hz = 50.0", "cutoff_hz = 50.0\ngain = 2", "gain"),

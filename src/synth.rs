@@ -557,7 +557,12 @@ pub struct Scored {
 /// Reduce a synthetic log with the default estimator (the geometry as a lab would
 /// enter it: nominal p from height and thickness) and score it against its truth.
 pub fn score(s: &Synthetic) -> Scored {
-    use crate::peaks::{analyse, PeakOptions, Physics};
+    score_with(s, &crate::peaks::PeakOptions::default())
+}
+
+/// [`score`] with the estimator's options given (a stated logger filter).
+pub fn score_with(s: &Synthetic, opts: &crate::peaks::PeakOptions) -> Scored {
+    use crate::peaks::{analyse, Physics};
     use crate::restitution::coefficients;
     let spec = &s.spec;
     let phys = Physics {
@@ -572,7 +577,7 @@ pub fn score(s: &Synthetic) -> Scored {
     let e_h = spec.e_housner();
     let truth: Vec<f64> = s.peaks.iter().take(6).map(|p| p.1).collect();
     let tc = coefficients(&truth, e_h).expect("six true peaks");
-    let res = analyse(&s.t, &s.x_mm, &phys, &PeakOptions::default());
+    let res = analyse(&s.t, &s.x_mm, &phys, opts);
     let (worst_pp, status) = match res {
         Err(e) => (Err(ScoreError::Peaks(e)), "error".to_string()),
         Ok(a) => {
@@ -601,4 +606,167 @@ pub fn score(s: &Synthetic) -> Scored {
         worst_pp,
         status,
     }
+}
+
+/// The data logger's filter of a synthetic test (issue #18): the motion is
+/// simulated on a grid 20× finer than the logger's, passed through the filter
+/// there, then sampled; the noise, spikes and quantisation come after it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Logger {
+    /// A causal analogue low-pass (Bessel or Butterworth), cut-off over f_s.
+    LowPass {
+        family: crate::signal::filter::Family,
+        order: usize,
+        fc_over_fs: f64,
+    },
+    /// A delta-sigma converter's linear-phase FIR: windowed sinc (Hamming), 64
+    /// logger samples long, cut-off over f_s.
+    Fir { fc_over_fs: f64 },
+}
+
+/// Oversampling of the fine grid the filter runs on.
+const FINE: usize = 20;
+
+impl Logger {
+    /// The low-pass as the manifest would state it, for a logger rate f_s.
+    pub fn stated(&self, fs_hz: f64) -> Option<crate::signal::filter::LowPass> {
+        match *self {
+            Logger::LowPass { family, order, fc_over_fs } => Some(crate::signal::filter::LowPass {
+                family,
+                order,
+                cutoff_hz: fc_over_fs * fs_hz,
+            }),
+            Logger::Fir { .. } => None,
+        }
+    }
+
+    /// The filter run over `x` sampled at `h` (s): the causal IIR in modal form
+    /// with the input linear between samples (first-order hold: a discretisation
+    /// independent of the estimator's, which places nodes at the kinks), or the
+    /// FIR's taps, each output only where `keep(i)` (the logger's samples).
+    fn apply(&self, x: &[f64], h: f64, fs_hz: f64, keep: impl Fn(usize) -> bool) -> Vec<f64> {
+        match self.stated(fs_hz) {
+            Some(lp) => {
+                let m = lp.modal();
+                let steps = m.step_coefficients(h);
+                let mut state = m.steady_state(x[0]);
+                let mut out = vec![x[0]];
+                for w in x.windows(2) {
+                    m.advance(&mut state, &steps, [w[0], (w[1] - w[0]) / h, 0.0, 0.0]);
+                    out.push(m.output(&state));
+                }
+                out
+            }
+            None => {
+                let Logger::Fir { fc_over_fs } = *self else { unreachable!() };
+                let taps = fir_taps(fc_over_fs / FINE as f64, 64 * FINE);
+                (0..x.len())
+                    .map(|i| {
+                        if !keep(i) {
+                            return 0.0;
+                        }
+                        // Causal: y_i = Σ_j b_j x_(i−j), the log held before its start.
+                        taps.iter().enumerate().map(|(j, b)| b * x[i.saturating_sub(j)]).sum()
+                    })
+                    .collect()
+            }
+        }
+    }
+}
+
+/// Windowed-sinc low-pass taps (Hamming), cut-off `fc` in cycles per sample,
+/// normalised to unit sum (scipy `firwin(n, 2 fc)`).
+fn fir_taps(fc: f64, n: usize) -> Vec<f64> {
+    let mid = 0.5 * (n as f64 - 1.0);
+    let mut b: Vec<f64> = (0..n)
+        .map(|i| {
+            let m = i as f64 - mid;
+            let x = 2.0 * fc * m;
+            let sinc = if x.abs() < 1e-12 {
+                1.0
+            } else {
+                (std::f64::consts::PI * x).sin() / (std::f64::consts::PI * x)
+            };
+            let w = 0.54 - 0.46 * (2.0 * std::f64::consts::PI * i as f64 / (n as f64 - 1.0)).cos();
+            2.0 * fc * sinc * w
+        })
+        .collect();
+    let sum: f64 = b.iter().sum();
+    b.iter_mut().for_each(|v| *v /= sum);
+    b
+}
+
+/// [`generate`] through a data logger's filter: the motion on a grid 20× finer
+/// than the logger's, filtered there, sampled, then noise, spikes and
+/// quantisation as in [`generate`]. The truth is the wall's motion, before the
+/// filter.
+pub fn generate_logged(spec: &TestSpec, logger: Logger) -> Synthetic {
+    let plain = generate(&TestSpec {
+        sigma_mm: 0.0,
+        spikes: 0,
+        ..spec.clone()
+    });
+    let mut rng = Rng::new(spec.seed ^ 0x10_66E5);
+    let t_r = HOLD_S + Rng::new(spec.seed ^ 0x5EED).uniform() / spec.fs_hz;
+    let motion = match &spec.contact {
+        Contact::Rigid { e } => rigid_motion(spec, e),
+        Contact::Compliant { theta_c, c_floor, c_wall } => compliant_motion(spec, *theta_c, *c_floor, *c_wall),
+    };
+    let n = plain.t.len();
+    let duration = n as f64 / spec.fs_hz;
+    let h = 1.0 / (spec.fs_hz * FINE as f64);
+    let clean: Vec<f64> = (0..n * FINE)
+        .map(|i| {
+            let ti = i as f64 * h;
+            spec.lever_mm * motion.theta_at(ti - t_r, spec.theta0).sin() + spec.drift_mm * ti / duration
+        })
+        .collect();
+    let seen = logger.apply(&clean, h, spec.fs_hz, |i| i % FINE == 0);
+    let mut x: Vec<f64> = (0..n).map(|i| seen[i * FINE] + spec.sigma_mm * rng.normal()).collect();
+    for _ in 0..spec.spikes {
+        let i = (rng.uniform() * n as f64) as usize % n;
+        x[i] += rng.pick(&[-1.0, 1.0]) * rng.range(20.0, 80.0) * spec.sigma_mm.max(0.01);
+    }
+    for v in x.iter_mut() {
+        *v = (*v * 100.0).round() / 100.0;
+    }
+    Synthetic { x_mm: x, ..plain }
+}
+
+/// Which filters a logged draw takes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LoggerDraw {
+    /// `family`, or Bessel or Butterworth at even odds where None; order 2–8,
+    /// cut-off uniform in [lo, hi] f_s.
+    Causal {
+        family: Option<crate::signal::filter::Family>,
+        lo: f64,
+        hi: f64,
+    },
+    /// The FIR with its cut-off uniform in 0.40–0.45 f_s.
+    Fir,
+}
+
+/// A random resolvable test ([`draw`]) and a random filter of `kind`, logged
+/// through it ([`generate_logged`]).
+pub fn draw_logged(seed: u64, family: Family, kind: LoggerDraw) -> (Synthetic, Logger) {
+    let spec = draw(seed, family).spec;
+    let mut r = Rng::new(spec.seed ^ 0xF117E5);
+    let logger = match kind {
+        LoggerDraw::Causal { family, lo, hi } => Logger::LowPass {
+            family: if let Some(f) = family {
+                f
+            } else if r.uniform() < 0.5 {
+                crate::signal::filter::Family::Bessel
+            } else {
+                crate::signal::filter::Family::Butterworth
+            },
+            order: 2 + (r.uniform() * 7.0) as usize % 7,
+            fc_over_fs: r.range(lo, hi),
+        },
+        LoggerDraw::Fir => Logger::Fir {
+            fc_over_fs: r.range(0.40, 0.45),
+        },
+    };
+    (generate_logged(&spec, logger), logger)
 }

@@ -122,3 +122,155 @@ fn random_compliant_tests_full_draw() {
     assert_eq!(silent, 0);
     assert!(rate >= 0.55, "success rate {rate}");
 }
+
+// ---- Issue #18: the data logger's filter ----
+
+use rocklab::peaks::acquisition::Acquisition;
+use rocklab::peaks::PeakOptions;
+use rocklab::signal::filter::Family as FilterFamily;
+use rocklab::synth::{draw_logged, score_with, LoggerDraw};
+
+/// Logged draws: each test through a random filter of `kind`, reduced with the
+/// filter stated in the options or not.
+fn run_logged(seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) -> Vec<Scored> {
+    seeds
+        .into_par_iter()
+        .map(|s| {
+            let (syn, logger) = draw_logged(s, Family::Rigid, kind);
+            let acquisition = match (stated, logger.stated(syn.spec.fs_hz)) {
+                (true, Some(lp)) => Acquisition::Stated(lp),
+                _ => Acquisition::Unknown,
+            };
+            let opts = PeakOptions {
+                acquisition,
+                ..PeakOptions::default()
+            };
+            let mut sc = score_with(&syn, &opts);
+            sc.status = format!("{} [{logger:?}]", sc.status);
+            sc
+        })
+        .collect()
+}
+
+/// (share ok and within 1 pp, tests ok but more than 2 pp off), the failures printed.
+fn summarise_logged(name: &str, scored: &[Scored]) -> (f64, usize) {
+    let is_ok = |s: &Scored| s.status.starts_with("ok ");
+    let mut good = 0;
+    let mut off = 0;
+    for s in scored {
+        match &s.worst_pp {
+            Ok(w) if is_ok(s) && *w <= 1.0 => good += 1,
+            Ok(w) => {
+                if is_ok(s) && *w > 2.0 {
+                    off += 1;
+                }
+                println!("{name} seed {}: {w:.2} pp [{}] fs {} Hz", s.seed, s.status, s.spec.fs_hz);
+            }
+            Err(e) => println!("{name} seed {}: error {e} [{}]", s.seed, s.status),
+        }
+    }
+    let rate = good as f64 / scored.len() as f64;
+    println!(
+        "{name}: {} tests, {:.1} % ok and within 1 pp, {off} ok but more than 2 pp off",
+        scored.len(),
+        100.0 * rate
+    );
+    (rate, off)
+}
+
+fn bessel(lo: f64, hi: f64) -> LoggerDraw {
+    LoggerDraw::Causal {
+        family: Some(FilterFamily::Bessel),
+        lo,
+        hi,
+    }
+}
+
+/// A few logged tests in the default run: a stated Bessel low-pass and an
+/// unstated FIR; none ok and more than 2 pp off.
+#[test]
+fn logged_tests_small_draw() {
+    let stated = run_logged(0..4, bessel(0.10, 0.40), true);
+    let (_, off) = summarise_logged("stated bessel", &stated);
+    assert_eq!(off, 0);
+    let fir = run_logged(0..3, LoggerDraw::Fir, false);
+    let (_, off) = summarise_logged("unstated fir", &fir);
+    assert_eq!(off, 0);
+}
+
+/// Issue #18, stated Bessel (order 2–8) at 0.10–0.40 f_s: the bound is the
+/// issue's 98 % ok within 1 pp, none ok and more than 2 pp off.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn stated_bessel_full_draw() {
+    let (rate, off) = summarise_logged("stated bessel", &run_logged(2000..2200, bessel(0.10, 0.40), true));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
+}
+
+/// Issue #18, unstated Bessel (order 2–8) at 0.25–0.40 f_s: ≥ 95 %.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn unstated_bessel_full_draw() {
+    let (rate, off) = summarise_logged("unstated bessel", &run_logged(3000..3200, bessel(0.25, 0.40), false));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.95, "success rate {rate}");
+}
+
+/// Issue #18, unstated FIR at 0.40–0.45 f_s: ≥ 98 %.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn unstated_fir_full_draw() {
+    let (rate, off) = summarise_logged("unstated fir", &run_logged(4000..4200, LoggerDraw::Fir, false));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
+}
+
+fn all_causal() -> LoggerDraw {
+    LoggerDraw::Causal {
+        family: None,
+        lo: 0.10,
+        hi: 0.45,
+    }
+}
+
+/// Both causal families (Bessel, Butterworth), order 2–8, over 0.10–0.45 f_s,
+/// stated: measured 99.0 % ok within 1 pp, none ok and more than 2 pp off.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn stated_causal_families_full_draw() {
+    let (rate, off) = summarise_logged("stated causal", &run_logged(5000..5200, all_causal(), true));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
+}
+
+/// The same, not stated: measured 98.5 % ok within 1 pp, and ONE test ok but
+/// 2.33 pp off (draw 6122, a Butterworth of order 8 at 0.32 f_s, 100 Hz, read
+/// as a Bessel 4 with no runner-up close enough to flag it). A known gap
+/// (docs/acquisition.md): this test fails until it is closed.
+#[test]
+#[ignore = "known gap, fails on one test (docs/acquisition.md): run in release"]
+fn unstated_causal_families_full_draw() {
+    let (rate, off) = summarise_logged("unstated causal", &run_logged(6000..6200, all_causal(), false));
+    assert_eq!(off, 0);
+    assert!(rate >= 0.98, "success rate {rate}");
+}
+
+/// The unstated-FIR draws that were ok but 1.0–1.9 pp off before the FIR was
+/// modelled (draw indices of `unstated_fir_full_draw`).
+#[test]
+fn fir_tests_once_missed_are_reduced() {
+    let missed = [4006, 4060, 4085, 4099, 4125, 4171, 4187];
+    let scored: Vec<Scored> = missed
+        .into_par_iter()
+        .map(|i| {
+            let (syn, logger) = draw_logged(i, Family::Rigid, LoggerDraw::Fir);
+            let mut sc = score_with(&syn, &PeakOptions::default());
+            sc.status = format!("{} [{logger:?}]", sc.status);
+            sc
+        })
+        .collect();
+    let (rate, off) = summarise_logged("fir once missed", &scored);
+    assert_eq!(off, 0);
+    assert!(rate >= 0.99, "{rate}");
+}

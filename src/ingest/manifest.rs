@@ -9,6 +9,8 @@ use serde::Deserialize;
 use crate::error::{FileError, FileKind};
 use crate::ingest::log::{Decimal, Delimiter, LogFormat};
 use crate::ingest::text::{parse_toml, read_text};
+use crate::peaks::acquisition::Acquisition;
+use crate::signal::filter::{Family, LowPass};
 pub use crate::wall::Rocking;
 use crate::wall::{housner_e, slenderness, Provenance, Wall};
 
@@ -55,8 +57,19 @@ struct RawManifest {
     wall: RawWall,
     channels: Option<RawChannels>,
     format: Option<RawFormat>,
+    acquisition: Option<RawAcquisition>,
     #[serde(default)]
     test: Vec<RawTest>,
+}
+
+/// `[acquisition]` or a test's `acquisition = { … }` (SPEC): the data logger's
+/// filter on the displacement channel.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAcquisition {
+    filter: String,
+    order: Option<i64>,
+    cutoff_hz: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -125,6 +138,7 @@ struct RawTest {
     outward_sign: Option<i64>,
     channels: Option<RawChannels>,
     format: Option<RawFormat>,
+    acquisition: Option<RawAcquisition>,
 }
 
 /// A validated test: every channel resolved.
@@ -142,6 +156,9 @@ pub struct TestSpec {
     pub format: LogFormat,
     /// Lever arm of the sensor about the hinge, m (sensor height − hinge height).
     pub lever_arm_m: f64,
+    /// The logger's filter: the test's own `acquisition`, else `[acquisition]`,
+    /// else not known.
+    pub acquisition: Acquisition,
 }
 
 /// A validated campaign.
@@ -240,6 +257,54 @@ fn parse_format(path: &Path, where_: &str, f: &RawFormat) -> Result<LogFormat> {
     Ok(LogFormat { delimiter, decimal })
 }
 
+/// An `acquisition` validated; `where_` names it in errors ("[acquisition]." or
+/// "[[test]] id = \"x\": acquisition.").
+fn parse_acquisition(path: &Path, where_: &str, a: &RawAcquisition) -> Result<Acquisition> {
+    let family = match a.filter.as_str() {
+        "none" | "unknown" => {
+            if a.order.is_some() || a.cutoff_hz.is_some() {
+                return Err(bad(
+                    path,
+                    format!(
+                        "{where_}filter = {:?}: order and cutoff_hz belong to a stated \"bessel\" or \"butterworth\" filter",
+                        a.filter
+                    ),
+                ));
+            }
+            return Ok(if a.filter == "none" { Acquisition::None } else { Acquisition::Unknown });
+        }
+        "bessel" => Family::Bessel,
+        "butterworth" => Family::Butterworth,
+        other => {
+            return Err(bad(
+                path,
+                format!("{where_}filter = {other:?}: expected \"none\", \"bessel\", \"butterworth\" or \"unknown\""),
+            ))
+        }
+    };
+    let order = a
+        .order
+        .ok_or_else(|| bad(path, format!("{where_}order is missing: a {} filter needs its order (1–8)", a.filter)))?;
+    if !(1..=8).contains(&order) {
+        return Err(bad(path, format!("{where_}order = {order}: expected an order from 1 to 8")));
+    }
+    let cutoff_hz = a.cutoff_hz.ok_or_else(|| {
+        bad(
+            path,
+            format!("{where_}cutoff_hz is missing: a {} filter needs its −3 dB frequency", a.filter),
+        )
+    })?;
+    // A cut-off within the range of a logger's rate (1 Hz – 1 MHz: limits.rs).
+    let cutoff_hz = crate::limits::LOG_RATE_HZ
+        .check(&format!("{where_}cutoff_hz"), cutoff_hz)
+        .map_err(|m| bad(path, m))?;
+    Ok(Acquisition::Stated(LowPass {
+        family,
+        order: order as usize,
+        cutoff_hz,
+    }))
+}
+
 /// The `[wall]` table validated: height, thickness, α and e_H with provenance.
 struct WallValues {
     height_m: f64,
@@ -297,6 +362,7 @@ struct Defaults<'a> {
     format: LogFormat,
     base: &'a Path,
     hinge_height_m: f64,
+    acquisition: Acquisition,
 }
 
 /// The channels of one test: its own, then its nested `channels`, then the defaults.
@@ -373,6 +439,10 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
             .check(&format!("{where_}imposed_displacement_mm"), x)
             .map_err(|m| bad(path, m))?;
     }
+    let acquisition = match &t.acquisition {
+        Some(a) => parse_acquisition(path, &format!("{where_}acquisition."), a)?,
+        None => d.acquisition,
+    };
     Ok(TestSpec {
         id: t.id.clone(),
         file: d.base.join(&t.file),
@@ -383,6 +453,7 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
         outward_sign,
         format,
         lever_arm_m,
+        acquisition,
     })
 }
 
@@ -397,6 +468,10 @@ fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
         },
         base: path.parent().unwrap_or_else(|| Path::new(".")),
         hinge_height_m: w.hinge_height_m,
+        acquisition: match &raw.acquisition {
+            Some(a) => parse_acquisition(path, "[acquisition].", a)?,
+            None => Acquisition::Unknown,
+        },
     };
     if raw.test.is_empty() {
         return Err(bad(path, "no [[test]] entries: expected at least one test"));
@@ -484,6 +559,69 @@ time = { column = "t_ms", unit = "ms" }
         assert_eq!(c.alpha_rad, 0.12);
         assert_eq!(c.e_housner, 0.97);
         assert!(matches!(c.e_housner_source, Provenance::Override(_)));
+    }
+
+    /// `[acquisition]` and the per-test override (SPEC), and located errors.
+    #[test]
+    fn acquisition_is_read_and_validated() {
+        let c = Campaign::parse(BASE, Path::new("m.toml")).unwrap();
+        assert_eq!(c.tests[0].acquisition, Acquisition::Unknown, "not stated: not known");
+        let stated = format!("{BASE}\n[acquisition]\nfilter = \"bessel\"\norder = 4\ncutoff_hz = 50.0\n");
+        let c = Campaign::parse(&stated, Path::new("m.toml")).unwrap();
+        let want = LowPass {
+            family: Family::Bessel,
+            order: 4,
+            cutoff_hz: 50.0,
+        };
+        assert_eq!(c.tests[1].acquisition, Acquisition::Stated(want));
+        let own = stated.replace(
+            "outward_sign = -1",
+            "outward_sign = -1\nacquisition = { filter = \"butterworth\", order = 6, cutoff_hz = 37.5 }",
+        );
+        let c = Campaign::parse(&own, Path::new("m.toml")).unwrap();
+        assert_eq!(c.tests[0].acquisition, Acquisition::Stated(want));
+        assert!(matches!(
+            c.tests[1].acquisition,
+            Acquisition::Stated(LowPass {
+                family: Family::Butterworth,
+                order: 6,
+                ..
+            })
+        ));
+        let none = own.replace("filter = \"butterworth\", order = 6, cutoff_hz = 37.5", "filter = \"none\"");
+        assert_eq!(
+            Campaign::parse(&none, Path::new("m.toml")).unwrap().tests[1].acquisition,
+            Acquisition::None
+        );
+        for (from, to, says) in [
+            (
+                "filter = \"bessel\"",
+                "filter = \"chebyshev\"",
+                "m.toml:23:1: [acquisition].filter = \"chebyshev\": expected",
+            ),
+            (
+                "order = 4",
+                "order = 12",
+                "m.toml:24:1: [acquisition].order = 12: expected an order from 1 to 8",
+            ),
+            (
+                "cutoff_hz = 50.0",
+                "cutoff_hz = -5.0",
+                "m.toml:25:1: [acquisition].cutoff_hz = -5: expected a value",
+            ),
+            ("order = 4\n", "", "[acquisition].order is missing"),
+            ("cutoff_hz = 50.0", "cutoff_hz = 50.0\ngain = 2", "gain"),
+        ] {
+            let err = Campaign::parse(&stated.replace(from, to), Path::new("m.toml")).unwrap_err().to_string();
+            assert!(err.contains(says), "{err}");
+        }
+        let err = Campaign::parse(&own.replace("order = 6", "order = 0"), Path::new("m.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("[[test]] id = \"b\": acquisition.order = 0") && err.contains("m.toml:"),
+            "{err}"
+        );
     }
 
     #[test]

@@ -131,10 +131,14 @@ pub fn reduce_test(campaign: &Campaign, spec: &TestSpec, options: &PeakOptions) 
 /// outward positive, as [`read_log`] returns it. Errors name `spec.file`.
 pub fn reduce_loaded(campaign: &Campaign, spec: &TestSpec, log: LogData, options: &PeakOptions) -> TestOutcome {
     let warnings = log.warnings.clone();
+    let options = PeakOptions {
+        acquisition: spec.acquisition,
+        ..*options
+    };
     let phys = physics(campaign, spec);
-    let result = crate::reduction::reduce_log(log, &phys, campaign.e_housner, options)
+    let result = crate::reduction::reduce_log(log, &phys, campaign.e_housner, &options)
         .map(|mut r| {
-            crate::reduction::resolve_impacts(&mut r, &phys, campaign.e_housner, campaign.alpha_rad, options);
+            crate::reduction::resolve_impacts(&mut r, &phys, campaign.e_housner, campaign.alpha_rad, &options);
             r
         })
         .map_err(|source| TestError::Reduce {

@@ -74,6 +74,7 @@
 //! No crate does this: it is a domain-specific piecewise model fit; the
 //! Levenberg–Marquardt loop is [`crate::fit`], the linear algebra nalgebra's.
 
+pub mod acquisition;
 pub mod checks;
 mod crossings;
 pub mod local;
@@ -126,6 +127,8 @@ pub struct PeakOptions {
     pub method: Method,
     /// Which impact model the default estimator takes.
     pub contacts: ContactModel,
+    /// The data logger's filter, as the manifest states it ([`acquisition`]).
+    pub acquisition: acquisition::Acquisition,
 }
 
 impl Default for PeakOptions {
@@ -134,6 +137,7 @@ impl Default for PeakOptions {
             n_peaks: 6,
             method: Method::Segments,
             contacts: ContactModel::FromLog,
+            acquisition: acquisition::Acquisition::Unknown,
         }
     }
 }
@@ -233,6 +237,9 @@ pub struct Analysis {
     pub local_peaks: Vec<Option<(f64, f64)>>,
     /// How each peak was read (default estimator; empty for Savitzky–Golay).
     pub methods: Vec<ReadingMethod>,
+    /// The logger's filter the model was seen through, and its source
+    /// ([`acquisition`]).
+    pub response: acquisition::ResponseUsed,
 }
 
 pub use local::ReadingMethod;
@@ -297,7 +304,7 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
     let prepared = prepare_log(t, x, opts.n_peaks)?;
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
-        Method::Segments => by_segments(t, prepared, phys, opts.n_peaks, opts.contacts),
+        Method::Segments => by_segments(t, prepared, phys, opts),
     }
 }
 
@@ -384,13 +391,20 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         gamma_fit: None,
         local_peaks: Vec::new(),
         methods: Vec::new(),
+        response: acquisition::ResponseUsed {
+            source: "not modelled (Savitzky–Golay)",
+            filter: None,
+            fir_cutoff_hz: None,
+        },
     }
 }
 
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
-fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts: ContactModel) -> Result<Analysis, PeakError> {
+fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
+    let n_peaks = opts.n_peaks;
+    let (filter, mut response) = acquisition::stated(&opts.acquisition);
     let fit = SegmentFit::run(&FitInput {
         t,
         x: &p.x,
@@ -400,8 +414,13 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         crossings: &p.crossings,
         phys,
         n_peaks,
-        contacts,
+        contacts: opts.contacts,
+        filter,
+        estimate_filter: opts.acquisition == acquisition::Acquisition::Unknown,
     })?;
+    if let Some((est, _)) = &fit.estimated {
+        response = est.used();
+    }
     let mut velocity = SavGol::new(7, 2).expect("valid").derivative(&p.x, p.dt);
     fit.fill_velocity(t, &mut velocity);
     let impacts = fit.impacts();
@@ -416,6 +435,12 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
+        if let Some((est, cutoff)) = &fit.estimated {
+            acquisition::add_cutoff_spread(&mut c, cutoff);
+            if let Some((_, other)) = &est.runner_up {
+                uncertainty::add_model_spread(&mut c, &impacts, other);
+            }
+        }
         c
     });
     let mut cov = cov;
@@ -433,6 +458,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
     let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
     let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma);
+    let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,
@@ -451,5 +477,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, n_peaks: usize, contacts:
         gamma_fit: fit.model().gamma(),
         local_peaks: local,
         methods,
+        response,
     })
 }

@@ -123,6 +123,19 @@ pub struct Model {
     /// gravity arcs ([`Model::gravity_arc_params`]); infinite turns it off.
     pub lever: f64,
     pub q: Vec<f64>,
+    /// The data logger's filter the samples went through, where stated or
+    /// estimated: the residuals then compare the samples with the model seen
+    /// through it ([`super::acquisition`]).
+    pub filter: Option<std::sync::Arc<dyn Instrument>>,
+}
+
+/// What the samples went through before they were logged (the data logger's
+/// filter, implemented in `acquisition.rs`): the model as the logger would have
+/// recorded it at the samples `t` (None where the model is undefined), and how
+/// late a smooth arc comes out of it (s).
+pub trait Instrument: std::fmt::Debug + Send + Sync {
+    fn seen(&self, model: &Model, t: &[f64]) -> Vec<Option<f64>>;
+    fn delay(&self) -> f64;
 }
 
 /// Where the gravity term is linearised on an arc of apex θ_m (θ* = β θ_m) when
@@ -418,6 +431,11 @@ impl Model {
         if !self.valid() {
             return false;
         }
+        if let Some(f) = &self.filter {
+            let seen = f.seen(self, t);
+            out.extend(seen.into_iter().zip(y).map(|(m, yi)| m.map_or(0.0, |m| yi - m)));
+            return true;
+        }
         out.extend(self.eval_many(t).zip(y).map(|(m, yi)| m.map_or(0.0, |(m, _)| yi - m)));
         true
     }
@@ -658,6 +676,7 @@ mod tests {
             min_len: 1e-3,
             lever: f64::INFINITY,
             q,
+            filter: None,
         };
         if contacts {
             m.with_contacts(0.01)

@@ -18,7 +18,10 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
             let i0 = i0.min(i1.saturating_sub(4)).max(fit.tw.partition_point(|&v| v < start));
             let inward_spring = m.one_sided && k % 2 == 1;
             let lambda = if inward_spring { m.lambda().unwrap_or(0.0) } else { -m.p().powi(2) };
-            let (slope, u) = checks::local_slope(&fit.tw[i0..i1], &fit.yw[i0..i1], end, lambda, sigma)?;
+            // Through a causal filter the arc's samples come out late by its
+            // group delay (the samples before the kink do not see it yet).
+            let late = m.filter.as_ref().map_or(0.0, |f| f.delay());
+            let (slope, u) = checks::local_slope(&fit.tw[i0..i1], &fit.yw[i0..i1], end + late, lambda, sigma)?;
             Some((slope, u))
         })
         .collect()

@@ -43,6 +43,9 @@ pub struct SegmentFit {
     /// The peaks of the instantaneous-impact model where contact phases were
     /// chosen (the model-form spread).
     pub alternative: Option<Vec<f64>>,
+    /// An unstated filter found and estimated, and the peaks of the fits at its
+    /// cut-off ± one standard uncertainty (the spread carried into u).
+    pub estimated: Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>,
 }
 
 /// Inputs of the fit.
@@ -56,6 +59,10 @@ pub struct FitInput<'a> {
     pub phys: &'a Physics,
     pub n_peaks: usize,
     pub contacts: ContactModel,
+    /// The logger's filter, where stated ([`super::acquisition`]).
+    pub filter: Option<std::sync::Arc<dyn super::model::Instrument>>,
+    /// No filter stated: look for one ([`super::acquisition::estimate`]).
+    pub estimate_filter: bool,
 }
 
 impl SegmentFit {
@@ -95,11 +102,8 @@ impl SegmentFit {
         // the noise the two extra fits would only cost time (3× on a
         // 2,000,000-row log).
         let expected = inp.contacts == ContactModel::Expected;
-        let windows: &[f64] = if expected || misses_around_impacts(&simple.model, &tw, &yw, dt, inp.sigma) {
-            &[2.0 * dt, 0.01f64.max(2.0 * dt)]
-        } else {
-            &[]
-        };
+        let misses = misses_around_impacts(&simple.model, &tw, &yw, dt, inp.sigma);
+        let windows: &[f64] = if expected || misses { &[2.0 * dt, 0.01f64.max(2.0 * dt)] } else { &[] };
         for &window in windows {
             let Some(c) = fit_model(simple.model.with_contacts(window), &tw, &yw, 100) else {
                 continue;
@@ -122,7 +126,13 @@ impl SegmentFit {
         // the model-form spread. (Where they were not, the contact fit's are not
         // used: on the idealised draw that raised the median stated u of a
         // table value from 0.27 to 0.34 pp, against a median error of 0.02 pp.)
-        let alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
+        let mut alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
+        // No filter stated: a low-pass rounds the kinks too.
+        let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
+        let estimated = rival_filter(inp.estimate_filter && misses, &simple, &chosen, penalty, &tw, &yw, inp.sigma);
+        if let Some((e, _)) = &estimated {
+            (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
+        }
         Ok(SegmentFit {
             rms: (chosen.fit.cost / n).sqrt(),
             fitted: chosen,
@@ -133,6 +143,7 @@ impl SegmentFit {
             contacts,
             outliers,
             alternative,
+            estimated,
         })
     }
 
@@ -194,6 +205,15 @@ impl SegmentFit {
         self.model().residuals(&self.tw, &self.yw, &mut r);
         r
     }
+}
+
+/// Where `look` (no filter stated, the plain fit misses the samples around its
+/// impacts): an estimated low-pass, if it beats `chosen` ([`super::acquisition::rival`]).
+type Rival = Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>;
+fn rival_filter(look: bool, plain: &Fitted, chosen: &Fitted, penalty: f64, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
+    let dt = (tw[tw.len() - 1] - tw[0]) / (tw.len() - 1) as f64;
+    look.then(|| super::acquisition::rival(plain, chosen, penalty, tw, yw, dt, sigma))
+        .flatten()
 }
 
 /// Isolated spikes the spike filter missed: a spike next to an impact, where the
@@ -286,6 +306,7 @@ fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: b
         min_len: 0.5 * dt,
         lever,
         q,
+        filter: inp.filter.clone(),
     }
 }
 

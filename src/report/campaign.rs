@@ -279,6 +279,10 @@ fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
                         r.analysis.spikes_removed
                     ),
                 ]);
+                notes.push(vec![
+                    t.spec.id.clone(),
+                    format!("data logger's filter: {}", r.analysis.response.describe()),
+                ]);
             }
         }
     }

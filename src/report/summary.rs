@@ -40,6 +40,9 @@ struct Reduction<'a> {
     u: Option<Uncertainties<'a>>,
     release_time_s: f64,
     impacts: Vec<ImpactDoc<'a>>,
+    /// The logger's filter the model was seen through: stated, estimated, or
+    /// none (issue #18).
+    acquisition: &'a crate::peaks::acquisition::ResponseUsed,
 }
 
 /// One entry of a test's `"impacts"`: the analysis' impact (time, side entered,
@@ -151,6 +154,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 u: r.uncertainty.as_ref().map(Uncertainties),
                 release_time_s: r.analysis.release_time_s,
                 impacts: impact_docs(&r.impacts),
+                acquisition: &r.analysis.response,
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }

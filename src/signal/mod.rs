@@ -1,6 +1,7 @@
 //! Signal processing of the numeric core: Savitzky–Golay smoothing differentiation
 //! and a robust noise level. No I/O here.
 
+pub mod filter;
 pub mod savgol;
 
 /// Median of a slice (copies; O(n) selection). NaN-free input expected.

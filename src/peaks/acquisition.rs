@@ -1,0 +1,599 @@
+//! The data logger's filter in the forward model (issue #18): a stated causal
+//! low-pass, and the detection and estimation of an unstated one.
+//!
+//! # A stated filter
+//! The logger samples r_i = (h ∗ y)(t_i), y the wall's motion (L sin θ) and h
+//! the impulse response of its analogue low-pass ([`crate::signal::filter`]).
+//! The model's y is piecewise smooth: closed-form arcs joined at kinks (the
+//! impacts: a jump of y'; the release: a jump of y''). Between nodes (the
+//! samples and every kink: the release, the onsets and ends of contact, the
+//! impacts) y is replaced by the cubic Hermite interpolant of its value and
+//! one-sided slopes, and the filter's modal states are advanced exactly over
+//! each piece ([`Modal::advance`]). The interpolation error is
+//! h⁴ max|y⁗| / 384 per node spacing h ≤ Δt: below 10⁻⁴ mm for the stiffest
+//! restraint arcs of the draws at 100 Hz (ω ≈ 60 rad/s, 50 mm), so a stated
+//! filter costs no accuracy. The filter starts in the steady state of the
+//! held wall (the model is constant before its release).
+//!
+//! Cost: one more pass over the window per model evaluation (a few complex
+//! multiply-adds per pole and sample); only a stated or estimated filter takes
+//! it, the plain path of a log without one is unchanged.
+//!
+//! # A linear-phase FIR
+//! A delta-sigma converter's FIR ([`Fir`]) is not causal about its centre; it
+//! is modelled by its kink responses,
+//!
+//!   r_i = y + (m₂/2) y″ + Σ_k [Δv_k C₁(t_i − t_k) + Δa_k G₂(t_i − t_k)],
+//!
+//! the jumps Δv, Δa of slope and curvature at every kink from one-sided differences of the model's exact slope (`kink_jumps`;
+//! the last impact, with no arc after it, takes the jumps of the impact two
+//! before it scaled by its arrival speed). Its delay of half its length shifts
+//! every time alike and is absorbed by the model's times.
+//!
+//! # An unstated filter
+//! See [`rival`]: where the plain model misses the samples around its impacts,
+//! three generic responses with their cut-off free (Bessel 4, Butterworth 4,
+//! the 64-sample FIR: [`Generic`]) are fitted ([`estimate`]); the best is kept
+//! where the data ask for it (Bayesian information criterion, one parameter)
+//! and it beats the contact-phase model; the cut-off's uncertainty and a
+//! runner-up response that fits nearly as well are carried into u, and where
+//! the runner-up's peak ratios differ by more than 0.01 the test is suspect
+//! ([`family_check`]).
+
+use std::sync::Arc;
+
+use nalgebra::Complex;
+
+use super::model::{fit_model, Fitted, Instrument, Model};
+use crate::signal::filter::{hermite_cubic, Family, Fir, LowPass, Modal, StepCoefficients};
+
+/// What the manifest says of the logger's filter (SPEC, `[acquisition]`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Acquisition {
+    /// `filter = "none"`: the samples are the sensor's instantaneous readings.
+    None,
+    /// A causal analogue low-pass, stated: modelled exactly.
+    Stated(LowPass),
+    /// `filter = "unknown"`, or no `[acquisition]` at all: detected and
+    /// estimated from the log ([`estimate`]).
+    #[default]
+    Unknown,
+}
+
+/// Which response the reduction of one test used, and where it came from
+/// (reported per test in `summary.json` and the report).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ResponseUsed {
+    /// "stated", "stated none", "estimated" or "not detected".
+    pub source: &'static str,
+    /// The low-pass the model was seen through, if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub filter: Option<LowPass>,
+    /// The cut-off of the linear-phase FIR (windowed sinc, Hamming, 64
+    /// samples) the model was seen through, if one was estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fir_cutoff_hz: Option<f64>,
+}
+
+impl ResponseUsed {
+    pub fn describe(&self) -> String {
+        match (self.filter, self.fir_cutoff_hz) {
+            (Some(f), _) => format!("{} ({})", self.source, f.describe()),
+            (None, Some(fc)) => format!("{} (linear-phase FIR, windowed sinc of 64 samples, cut-off {fc:.3} Hz)", self.source),
+            _ => self.source.to_string(),
+        }
+    }
+}
+
+/// A filter as the model carries it: a causal low-pass in modal form, or a
+/// linear-phase FIR by its kink responses.
+#[derive(Debug, Clone)]
+pub struct ModelFilter {
+    pub response: Response,
+    /// Group delay at DC (s) of a causal filter: a smooth arc comes out of it
+    /// this late (0 for the FIR, taken about its centre).
+    pub delay: f64,
+}
+
+#[derive(Debug, Clone)]
+pub enum Response {
+    Causal(Modal),
+    Fir(Fir),
+}
+
+impl Instrument for ModelFilter {
+    fn seen(&self, model: &Model, t: &[f64]) -> Vec<Option<f64>> {
+        through_filter(model, self, t)
+    }
+    fn delay(&self) -> f64 {
+        self.delay
+    }
+}
+
+impl ModelFilter {
+    pub fn new(modal: Modal) -> Arc<ModelFilter> {
+        let delay = modal.group_delay();
+        Arc::new(ModelFilter {
+            response: Response::Causal(modal),
+            delay,
+        })
+    }
+    pub fn fir(fir: Fir) -> Arc<ModelFilter> {
+        Arc::new(ModelFilter {
+            response: Response::Fir(fir),
+            delay: 0.0,
+        })
+    }
+}
+
+/// The filter a stated acquisition puts in the model, and how the report names it.
+pub fn stated(acq: &Acquisition) -> (Option<Arc<dyn Instrument>>, ResponseUsed) {
+    match acq {
+        Acquisition::Stated(lp) => (
+            Some(ModelFilter::new(lp.modal()) as Arc<dyn Instrument>),
+            ResponseUsed {
+                source: "stated",
+                filter: Some(*lp),
+                fir_cutoff_hz: None,
+            },
+        ),
+        Acquisition::None => (
+            None,
+            ResponseUsed {
+                source: "stated none",
+                filter: None,
+                fir_cutoff_hz: None,
+            },
+        ),
+        Acquisition::Unknown => (
+            None,
+            ResponseUsed {
+                source: "not detected",
+                filter: None,
+                fir_cutoff_hz: None,
+            },
+        ),
+    }
+}
+
+/// One node of the piecewise-cubic input: its time, the sample it is (if any),
+/// and whether the model has a kink there (slopes differ on either side).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    t: f64,
+    sample: Option<usize>,
+    kink: bool,
+}
+
+/// The times where the model's slope or curvature jumps: the release, the
+/// onset of each contact (the impact without contact phases) and its end.
+fn kinks(model: &Model) -> Vec<f64> {
+    let mut out = vec![model.release_time()];
+    for k in 0..model.m() {
+        out.push(model.onset(k));
+        let end = model.release_from_contact(k);
+        if end > model.onset(k) && k + 1 < model.m() {
+            out.push(end);
+        }
+    }
+    out.sort_by(f64::total_cmp);
+    out
+}
+
+/// The samples and the kinks in time order, from the release (or the first
+/// sample, whichever is earlier).
+fn nodes(model: &Model, t: &[f64]) -> Vec<Node> {
+    let kinks = kinks(model);
+    let start = t[0].min(kinks[0]);
+    let mut out = Vec::with_capacity(t.len() + kinks.len() + 1);
+    if start < t[0] {
+        out.push(Node {
+            t: start,
+            sample: None,
+            kink: false,
+        });
+    }
+    let mut j = 0;
+    // A kink within this of a sample is taken at the sample (its left slope kept).
+    let tol = 1e-9 * (t[t.len() - 1] - t[0]).max(1.0);
+    for (i, &ti) in t.iter().enumerate() {
+        while j < kinks.len() && kinks[j] < ti - tol {
+            if kinks[j] > start + tol {
+                out.push(Node {
+                    t: kinks[j],
+                    sample: None,
+                    kink: true,
+                });
+            }
+            j += 1;
+        }
+        let kink = j < kinks.len() && (kinks[j] - ti).abs() <= tol;
+        if kink {
+            j += 1;
+        }
+        out.push(Node {
+            t: ti,
+            sample: Some(i),
+            kink,
+        });
+    }
+    out
+}
+
+/// The model seen through the filter at the samples `t` (sorted): None where the
+/// model is undefined (past its last impact).
+pub fn through_filter(model: &Model, filter: &ModelFilter, t: &[f64]) -> Vec<Option<f64>> {
+    match &filter.response {
+        Response::Causal(modal) => through_causal(model, modal, t),
+        Response::Fir(fir) => through_fir(model, fir, t),
+    }
+}
+
+/// Slope jump Δv and curvature jump Δa of the model at each of its kinks
+/// (one-sided differences of its exact slope). The last impact has no arc after
+/// it: its jumps are taken from the impact two before it (the same direction),
+/// scaled by the speed it arrives with.
+fn kink_jumps(model: &Model) -> Vec<(f64, f64, f64)> {
+    const E: f64 = 1e-9;
+    const D: f64 = 1e-5;
+    let slope = |t: f64| model.eval(t).map(|(_, v)| v);
+    let mut out: Vec<(f64, f64, f64)> = Vec::new();
+    for b in kinks(model) {
+        let (Some(vl), Some(vl2)) = (slope(b - E), slope(b - D)) else { continue };
+        let al = (vl - vl2) / (D - E);
+        match (slope(b + E), slope(b + D)) {
+            (Some(vr), Some(vr2)) => out.push((b, vr - vl, (vr2 - vr) / (D - E) - al)),
+            _ => {
+                // The last impact: the jumps of the impact two kinks of the same
+                // kind before it, scaled by the arrival speeds.
+                let like = out.iter().rev().nth(1).copied();
+                if let Some((tb, dv, da)) = like {
+                    let v_then = slope(tb - E).unwrap_or(0.0);
+                    let scale = if v_then.abs() > 1e-9 { vl / v_then } else { 0.0 };
+                    out.push((b, dv * scale, da));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The model seen through a linear-phase FIR ([`Fir`]): y + (m₂/2) y″ plus the
+/// kink responses Δv C₁ + Δa G₂ of every kink within half its length.
+fn through_fir(model: &Model, fir: &Fir, t: &[f64]) -> Vec<Option<f64>> {
+    const D: f64 = 1e-5;
+    let jumps = kink_jumps(model);
+    let plus: Vec<f64> = t.iter().map(|v| v + D).collect();
+    let minus: Vec<f64> = t.iter().map(|v| v - D).collect();
+    let at = model.eval_many(t);
+    let up = model.eval_many(&plus);
+    let dn = model.eval_many(&minus);
+    at.zip(up.zip(dn))
+        .zip(t)
+        .map(|((a, (u, d)), &ti)| {
+            let (y, _) = a?;
+            let curvature = match (u, d) {
+                (Some((_, vu)), Some((_, vd))) => (vu - vd) / (2.0 * D),
+                _ => 0.0,
+            };
+            let kinks: f64 = jumps
+                .iter()
+                .map(|&(tk, dv, da)| {
+                    let (c1, g2) = fir.kink(ti - tk);
+                    dv * c1 + da * g2
+                })
+                .sum();
+            Some(y + fir.m2_half * curvature + kinks)
+        })
+        .collect()
+}
+
+/// The model through a causal low-pass: piecewise-cubic input, exact modal steps.
+fn through_causal(model: &Model, modal: &Modal, t: &[f64]) -> Vec<Option<f64>> {
+    let mut out = vec![None; t.len()];
+    if t.is_empty() {
+        return out;
+    }
+    let nodes = nodes(model, t);
+    // Slopes just left of every kink (ε = 1 ns), values and right slopes at every node.
+    const EPS: f64 = 1e-9;
+    let mut query = Vec::with_capacity(nodes.len() * 2);
+    for n in &nodes {
+        if n.kink {
+            query.push(n.t - EPS);
+        }
+        query.push(n.t);
+    }
+    let evals: Vec<Option<(f64, f64)>> = model.eval_many(&query).collect();
+    let step = if t.len() > 1 { t[1] - t[0] } else { 1.0 };
+    let cached: StepCoefficients = modal.step_coefficients(step);
+    let mut q = 0;
+    let mut state: Vec<Complex<f64>> = Vec::new();
+    let mut prev: Option<(f64, f64, f64)> = None;
+    for n in &nodes {
+        let left = if n.kink {
+            q += 1;
+            evals[q - 1]
+        } else {
+            None
+        };
+        let Some((y, v)) = evals[q] else { break };
+        q += 1;
+        let v_left = left.map_or(v, |(_, vl)| vl);
+        match prev {
+            None => state = modal.steady_state(y),
+            Some((t0, y0, v0)) => {
+                let h = n.t - t0;
+                if h > 0.0 {
+                    let c = hermite_cubic(y0, v0, y, v_left, h);
+                    if (h - step).abs() <= 1e-9 * step {
+                        modal.advance(&mut state, &cached, c);
+                    } else {
+                        modal.advance(&mut state, &modal.step_coefficients(h), c);
+                    }
+                }
+            }
+        }
+        prev = Some((n.t, y, v));
+        if let Some(i) = n.sample {
+            out[i] = Some(modal.output(&state));
+        }
+    }
+    out
+}
+
+/// The generic responses an unstated filter is estimated as: a causal
+/// low-pass (Bessel, order 4: the smooth rounding and delay of most analogue
+/// front ends) or a delta-sigma converter's linear-phase FIR (windowed sinc,
+/// Hamming, 64 samples).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Generic {
+    Bessel4,
+    Butterworth4,
+    Fir64,
+}
+
+impl Generic {
+    fn lowpass(self, fc: f64) -> LowPass {
+        LowPass {
+            family: if self == Generic::Butterworth4 {
+                Family::Butterworth
+            } else {
+                Family::Bessel
+            },
+            order: 4,
+            cutoff_hz: fc,
+        }
+    }
+    /// The range of cut-offs searched, as fractions of the sampling rate.
+    /// Bessel: from below the lowest setting of the draws (0.1 f_s) to where it
+    /// delays by less than half a sample (0.7 f_s: no longer visible). FIR: the
+    /// converters' 0.40–0.45 f_s with a margin, up to the Nyquist rate.
+    fn search(self) -> (f64, f64) {
+        match self {
+            Generic::Bessel4 | Generic::Butterworth4 => (0.07, 0.7),
+            Generic::Fir64 => (0.3, 0.5),
+        }
+    }
+    /// The model filter at `fc` (Hz) for the sampling interval `dt`.
+    fn filter(self, fc: f64, dt: f64) -> Arc<dyn Instrument> {
+        match self {
+            Generic::Bessel4 | Generic::Butterworth4 => ModelFilter::new(self.lowpass(fc).modal()),
+            Generic::Fir64 => ModelFilter::fir(Fir::new(fc, 64, dt)),
+        }
+    }
+}
+
+/// An unstated filter's estimate: the fit through it, the low-pass and how
+/// well the data pin its cut-off.
+#[derive(Debug, Clone)]
+pub struct Estimate {
+    pub fitted: Fitted,
+    pub kind: Generic,
+    pub cutoff_hz: f64,
+    /// Cost decrease over the unfiltered fit, in units of σ².
+    pub gain: f64,
+    /// Standard uncertainty of ln f_c from the cost's curvature (2σ² / cost''),
+    /// None where the cost is flat.
+    pub u_ln_fc: Option<f64>,
+    /// The runner-up response, where it fits the log nearly as well (cost
+    /// within 2 ln n σ²): its kind and peaks.
+    pub runner_up: Option<(Generic, Vec<f64>)>,
+}
+
+impl Estimate {
+    /// How the report names it.
+    pub fn used(&self) -> ResponseUsed {
+        match self.kind {
+            Generic::Bessel4 | Generic::Butterworth4 => ResponseUsed {
+                source: "estimated",
+                filter: Some(self.kind.lowpass(self.cutoff_hz)),
+                fir_cutoff_hz: None,
+            },
+            Generic::Fir64 => ResponseUsed {
+                source: "estimated",
+                filter: None,
+                fir_cutoff_hz: Some(self.cutoff_hz),
+            },
+        }
+    }
+}
+
+/// Fit `start` seen through the generic response `kind` at `fc` (Hz).
+fn fit_through(start: &Model, kind: Generic, fc: f64, dt: f64, tw: &[f64], yw: &[f64], iters: usize) -> Option<Fitted> {
+    let mut m = start.clone();
+    m.filter = Some(kind.filter(fc, dt));
+    fit_model(m, tw, yw, iters)
+}
+
+/// Estimate an unstated causal low-pass: the cut-off that minimises the fit's
+/// cost, by golden-section search on ln f_c over [0.07, 0.7] f_s (each point a
+/// fit of every model parameter, warm-started from the best so far), then a
+/// parabola through the three best points for its curvature. `plain` is the
+/// unfiltered fit.
+pub fn estimate(plain: &Fitted, kind: Generic, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Option<Estimate> {
+    let fs = 1.0 / dt;
+    let sigma2 = sigma.powi(2).max(1e-12);
+    let mut seen: Vec<(f64, f64)> = Vec::new();
+    let mut best: Option<(f64, Fitted)> = None;
+    let eval = |x: f64, best: &mut Option<(f64, Fitted)>, seen: &mut Vec<(f64, f64)>| -> f64 {
+        let start = best.as_ref().map_or(&plain.model, |b| &b.1.model);
+        let cost = match fit_through(start, kind, fs * x.exp(), dt, tw, yw, 40) {
+            Some(f) => {
+                let c = f.fit.cost;
+                if best.as_ref().is_none_or(|b| c < b.1.fit.cost) {
+                    *best = Some((x, f));
+                }
+                c
+            }
+            None => f64::INFINITY,
+        };
+        seen.push((x, cost));
+        cost
+    };
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (lo, hi) = kind.search();
+    let (mut a, mut b) = (lo.ln(), hi.ln());
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let mut fc_ = eval(c, &mut best, &mut seen);
+    let mut fd = eval(d, &mut best, &mut seen);
+    while b - a > 0.03 {
+        if fc_ < fd {
+            b = d;
+            d = c;
+            fd = fc_;
+            c = b - g * (b - a);
+            fc_ = eval(c, &mut best, &mut seen);
+        } else {
+            a = c;
+            c = d;
+            fc_ = fd;
+            d = a + g * (b - a);
+            fd = eval(d, &mut best, &mut seen);
+        }
+    }
+    let (x, fitted) = best?;
+    // A final polish at the best cut-off.
+    let fitted = fit_through(&fitted.model, kind, fs * x.exp(), dt, tw, yw, 60)
+        .filter(|f| f.fit.cost <= fitted.fit.cost)
+        .unwrap_or(fitted);
+    let u_ln_fc = curvature_u(&seen, sigma2);
+    Some(Estimate {
+        gain: (plain.fit.cost - fitted.fit.cost) / sigma2,
+        kind,
+        cutoff_hz: fs * x.exp(),
+        runner_up: None,
+        fitted,
+        u_ln_fc,
+    })
+}
+
+/// σ of the minimiser of a least-squares cost sampled at (x, cost): the
+/// parabola through the three lowest points, u² = 2σ²/cost''.
+fn curvature_u(seen: &[(f64, f64)], sigma2: f64) -> Option<f64> {
+    let mut pts: Vec<(f64, f64)> = seen.iter().copied().filter(|p| p.1.is_finite()).collect();
+    pts.sort_by(|p, q| p.1.total_cmp(&q.1));
+    let [(x0, y0), (x1, y1), (x2, y2)] = pts.get(..3)?.try_into().ok()?;
+    let d = (x0 - x1) * (x0 - x2) * (x1 - x2);
+    if d.abs() < 1e-300 {
+        return None;
+    }
+    let curv = 2.0 * (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
+    (curv > 0.0).then(|| (2.0 * sigma2 / curv).sqrt())
+}
+
+/// Where the plain fit misses the samples around its impacts and no filter is
+/// stated: estimate one ([`estimate`]) and keep it where the data ask for it
+/// and it explains them better than the model chosen without it (`chosen`,
+/// plain or with contact phases, whose extra parameters cost `penalty` σ²):
+/// the Bayesian information criterion, cost/σ² + k ln n with k = 1 for the
+/// cut-off; and not at either end of the searched range.
+/// Compliant contacts also round the kinks, but each by its own contact and
+/// before θ = 0 as well, where a causal filter rounds every kink alike and only
+/// after it: on the MuJoCo campaigns the contact phases win. Returns the
+/// estimate and the peaks of the fits at f_c e^(±u) (their spread is a term of u).
+pub fn rival(plain: &Fitted, chosen: &Fitted, penalty: f64, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Option<(Estimate, Vec<Vec<f64>>)> {
+    let (n, sigma2) = (tw.len() as f64, sigma.powi(2).max(1e-12));
+    let mut found: Vec<Estimate> = [Generic::Bessel4, Generic::Butterworth4, Generic::Fir64]
+        .into_iter()
+        .filter_map(|kind| estimate(plain, kind, tw, yw, dt, sigma))
+        .filter(|e| {
+            // At either end of the range the cost has no minimum inside it:
+            // not a filter's signature (at the top none is visible; at the
+            // bottom of the causal range the rounding is wider than any
+            // setting of a logger's displacement channel: a compliant
+            // contact's, the one-sided MuJoCo test P1_90_1).
+            let (lo, hi) = e.kind.search();
+            let x = e.cutoff_hz * dt;
+            x < 0.95 * hi && x > 1.05 * lo && e.gain > n.ln()
+        })
+        .collect();
+    found.sort_by(|a, b| a.fitted.fit.cost.total_cmp(&b.fitted.fit.cost));
+    let mut found = found.into_iter();
+    let mut est = found.next()?;
+    let m = plain.model.m();
+    if let Some(r) = found.next().filter(|r| r.fitted.fit.cost - est.fitted.fit.cost < 2.0 * n.ln() * sigma2) {
+        est.runner_up = Some((r.kind, (0..m).map(|k| r.fitted.model.peak(k).1).collect()));
+    }
+    let bic_filter = est.fitted.fit.cost / sigma2 + n.ln();
+    let bic_chosen = chosen.fit.cost / sigma2 + penalty;
+    if bic_filter >= bic_chosen {
+        return None;
+    }
+    let u = est.u_ln_fc.unwrap_or(0.5).min(0.5);
+    let spread: Vec<Vec<f64>> = [-u, u]
+        .iter()
+        .filter_map(|d| fit_through(&est.fitted.model, est.kind, est.cutoff_hz * d.exp(), dt, tw, yw, 40))
+        .map(|f| (0..m).map(|k| f.model.peak(k).1).collect())
+        .collect();
+    Some((est, spread))
+}
+
+/// The estimated cut-off's share of the peaks' covariance: with v± the peaks of
+/// the fits at f_c e^(±u), d = (v₊ − v₋)/2 is one standard uncertainty of every
+/// peak from one cause (fully correlated): Σ += d dᵀ.
+pub(super) fn add_cutoff_spread(cov: &mut [Vec<f64>], spread: &[Vec<f64>]) {
+    let [lo, hi] = spread else { return };
+    let d: Vec<f64> = (0..cov.len())
+        .map(|k| match (lo.get(k), hi.get(k)) {
+            (Some(a), Some(b)) if (b - a).is_finite() => 0.5 * (b - a),
+            _ => 0.0,
+        })
+        .collect();
+    for (a, row) in cov.iter_mut().enumerate() {
+        for (b, c) in row.iter_mut().enumerate() {
+            *c += d[a] * d[b];
+        }
+    }
+}
+
+/// Where the runner-up response fits the log nearly as well as the chosen one,
+/// the ratios of consecutive peaks (what the table values are made of) must
+/// agree between them to 0.01 (1 pp of e): otherwise the log cannot say which
+/// response the logger had, and the test is suspect with that reason.
+pub fn family_check(est: &Estimate, peaks: &[f64]) -> Option<String> {
+    let (kind, other) = est.runner_up.as_ref()?;
+    let worst = (0..peaks.len().min(other.len()).saturating_sub(1))
+        .map(|k| (peaks[k + 1] / peaks[k] - other[k + 1] / other[k]).abs())
+        .fold(0.0, f64::max);
+    (worst > 0.01).then(|| {
+        format!(
+            "the logger's filter is not stated and the log cannot tell {:?} from {:?} (both fit it), whose ratios of consecutive peaks differ by {:.3}",
+            est.kind, kind, worst
+        )
+    })
+}
+
+/// The verdict of the checks with [`family_check`]'s reason added, if any.
+pub(super) fn with_family_check(verdict: super::Quality, est: Option<&Estimate>, peaks: &[super::Peak]) -> super::Quality {
+    let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
+    match (verdict, est.and_then(|e| family_check(e, &v))) {
+        (q, None) => q,
+        (super::Quality::Ok, Some(why)) => super::Quality::Suspect(vec![why]),
+        (super::Quality::Suspect(mut r), Some(why)) => {
+            r.push(why);
+            super::Quality::Suspect(r)
+        }
+    }
+}

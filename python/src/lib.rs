@@ -367,6 +367,16 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
     Ok(doc.to_string())
 }
 
+/// The two table files of an archive (`rocklab archive`), an interrupted change
+/// finished or discarded first.
+#[pyfunction]
+fn archive_tables(py: Python<'_>, archive: PathBuf) -> PyResult<Vec<String>> {
+    guarded(py, move || {
+        let paths = rocklab::archive::open(&archive)?;
+        Ok(paths.iter().map(|p| p.display().to_string()).collect())
+    })
+}
+
 /// Scale factors of `--scales FROM:TO:N`.
 #[pyfunction]
 fn parse_scales(py: Python<'_>, text: &str) -> PyResult<Vec<f64>> {
@@ -469,6 +479,7 @@ fn _rocklab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(facade, m)?)?;
     m.add_function(wrap_pyfunction!(parse_scales, m)?)?;
+    m.add_function(wrap_pyfunction!(archive_tables, m)?)?;
     m.add_function(wrap_pyfunction!(study_info, m)?)?;
     m.add_function(wrap_pyfunction!(facade_runs, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;

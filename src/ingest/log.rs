@@ -70,6 +70,8 @@ pub struct LogReader {
     time_scale: f64,
     disp_column: String,
     disp_scale: f64,
+    /// Sheet or group of a structured log (`.xlsx`, `.tdms`; see `ingest::formats`).
+    source: crate::ingest::formats::Source,
 }
 
 impl LogReader {
@@ -83,7 +85,13 @@ impl LogReader {
             time_scale: 1.0,
             disp_column: "disp_mm".into(),
             disp_scale: 1.0,
+            source: Default::default(),
         }
+    }
+    /// Sheet (`.xlsx`) or group (`.tdms`) holding the channels.
+    pub fn source(mut self, source: crate::ingest::formats::Source) -> Self {
+        self.source = source;
+        self
     }
     pub fn format(mut self, f: LogFormat) -> Self {
         self.format = f;
@@ -104,7 +112,22 @@ impl LogReader {
 
     /// Read the file.
     pub fn read(&self) -> Result<LogData, InputError> {
+        if let Some(kind) = crate::ingest::formats::Kind::of(&self.path) {
+            return crate::ingest::formats::read(kind, &self.request());
+        }
         self.parse(&crate::ingest::text::read_bytes(&self.path)?)
+    }
+
+    /// What a structured-format reader needs (`ingest::formats`).
+    fn request(&self) -> crate::ingest::formats::Request<'_> {
+        crate::ingest::formats::Request {
+            file: &self.path,
+            time_column: &self.time_column,
+            time_scale: self.time_scale,
+            disp_column: &self.disp_column,
+            disp_scale: self.disp_scale,
+            source: &self.source,
+        }
     }
 
     /// Parse the bytes of a log (the path only names it in messages).

@@ -103,6 +103,10 @@ struct RawChannels {
     time: Option<TimeChannel>,
     displacement: Option<DisplacementChannel>,
     outward_sign: Option<i64>,
+    /// Sheet of an `.xlsx` log (default: the first).
+    sheet: Option<String>,
+    /// Group of a `.tdms` log (default: the one holding the channel).
+    group: Option<String>,
 }
 
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -125,6 +129,8 @@ struct RawTest {
     outward_sign: Option<i64>,
     channels: Option<RawChannels>,
     format: Option<RawFormat>,
+    sheet: Option<String>,
+    group: Option<String>,
 }
 
 /// A validated test: every channel resolved.
@@ -140,6 +146,8 @@ pub struct TestSpec {
     /// +1 when a positive reading means outward, −1 when it means inward.
     pub outward_sign: f64,
     pub format: LogFormat,
+    /// Sheet (`.xlsx`) or group (`.tdms`) holding the channels.
+    pub source: crate::ingest::formats::Source,
     /// Lever arm of the sensor about the hinge, m (sensor height − hinge height).
     pub lever_arm_m: f64,
 }
@@ -162,6 +170,9 @@ pub struct Campaign {
     pub e_housner: f64,
     pub e_housner_source: Provenance,
     pub tests: Vec<TestSpec>,
+    /// SHA-256 (hex) of the manifest's text: the key of its reductions in a lab's
+    /// archive (`rocklab archive`).
+    pub manifest_sha256: String,
 }
 
 impl Campaign {
@@ -191,7 +202,12 @@ impl Campaign {
     /// Parse and validate manifest text; `path` names it in errors and resolves the
     /// test files.
     pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
-        validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
+        let mut c = validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))?;
+        c.manifest_sha256 = {
+            use sha2::{Digest, Sha256};
+            Sha256::digest(text.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+        };
+        Ok(c)
     }
 }
 
@@ -361,8 +377,18 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
         displacement,
         outward_sign,
         format,
+        source: test_source(t, d),
         lever_arm_m,
     })
+}
+
+/// Sheet and group of one test: its own, then its nested `channels`, then the defaults.
+fn test_source(t: &RawTest, d: &Defaults) -> crate::ingest::formats::Source {
+    let nested = t.channels.as_ref();
+    crate::ingest::formats::Source {
+        sheet: t.sheet.clone().or(nested.and_then(|c| c.sheet.clone())).or(d.channels.sheet.clone()),
+        group: t.group.clone().or(nested.and_then(|c| c.group.clone())).or(d.channels.group.clone()),
+    }
 }
 
 fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
@@ -392,6 +418,7 @@ fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
         tests.push(validate_test(t, &defaults, path)?);
     }
     Ok(Campaign {
+        manifest_sha256: String::new(),
         name: raw.campaign.name,
         rocking: raw.campaign.rocking,
         manifest_path: path.to_path_buf(),

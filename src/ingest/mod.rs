@@ -4,6 +4,7 @@
 
 pub mod block;
 pub mod calibration;
+pub mod formats;
 pub mod log;
 pub mod manifest;
 pub mod record;

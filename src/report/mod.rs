@@ -9,6 +9,7 @@ pub mod campaign;
 pub mod docs;
 pub mod facade;
 pub mod html;
+pub mod parquet;
 pub mod plots;
 pub mod response;
 pub mod summary;
@@ -26,6 +27,8 @@ pub enum ReportError {
     Plot(String),
     #[error("CSV: {0}")]
     Csv(#[from] csv::Error),
+    #[error("Parquet: {0}")]
+    Parquet(String),
     #[error("JSON: {0}")]
     Json(#[from] serde_json::Error),
     #[error("TOML: {0}")]

@@ -254,12 +254,15 @@ pub fn query(archive: &Path, sql: &str) -> Result<DataFrame, ArchiveError> {
 }
 
 /// A frame as an aligned text table: every row and column (polars' own display
-/// elides them past a limit), numbers as polars prints them, nulls as "null".
+/// elides them past a limit), floats in full (the shortest text that reads back
+/// as the same f64; polars' display rounds to 6 digits), nulls as "null".
 pub fn show(df: &DataFrame) -> String {
     let cell = |c: &Column, i: usize| match c.get(i) {
         Ok(AnyValue::String(s)) => s.to_string(),
         Ok(AnyValue::StringOwned(s)) => s.to_string(),
         Ok(AnyValue::Null) => "null".to_string(),
+        Ok(AnyValue::Float64(v)) => v.to_string(), // shortest text that reads back exactly
+        Ok(AnyValue::Float32(v)) => v.to_string(),
         Ok(v) => v.to_string(),
         Err(e) => format!("<{e}>"),
     };
@@ -279,6 +282,6 @@ pub fn show(df: &DataFrame) -> String {
             out.push('\n');
         }
     }
-    out.push_str(&format!("({} rows)", df.height()));
+    out.push_str(&format!("({} row{})", df.height(), if df.height() == 1 { "" } else { "s" }));
     out
 }

@@ -5,6 +5,8 @@
 //! The csv crate splits the records (it handles quoting and CRLF and reports line
 //! numbers); numbers are parsed here so that a decimal comma costs no copy of the
 //! file. Every defect is an [`InputError`] naming the file, line and column.
+//! Logs in the loggers' own formats (.xlsx, .tdms, .mat, .parquet, by extension)
+//! are handed to `ingest::formats` by [`LogReader::read`].
 
 use std::path::{Path, PathBuf};
 

@@ -462,6 +462,21 @@ time = { column = "t_ms", unit = "ms" }
 "#;
 
     #[test]
+    fn sheet_and_group_come_from_the_test_then_channels() {
+        let text = BASE
+            .replace("outward_sign = 1\n[[test]]", "outward_sign = 1\nsheet = \"log\"\ngroup = \"g\"\n[[test]]")
+            .replace("file = \"b.csv\"", "file = \"b.csv\"\nsheet = \"other\"");
+        let c = Campaign::parse(&text, Path::new("/x/campaign.toml")).unwrap();
+        assert_eq!(c.tests[0].source.sheet.as_deref(), Some("log"));
+        assert_eq!(c.tests[1].source.sheet.as_deref(), Some("other"));
+        assert_eq!(c.tests[1].source.group.as_deref(), Some("g"));
+        // The manifest's hash, the archive's key: SHA-256 of its text.
+        assert_eq!(c.manifest_sha256.len(), 64);
+        let other = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
+        assert_ne!(c.manifest_sha256, other.manifest_sha256);
+    }
+
+    #[test]
     fn defaults_merge_with_overrides() {
         let c = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
         assert_eq!(c.tests[0].time.column, "time_s");

@@ -299,6 +299,62 @@ fn demo_writes_tables_and_plots() {
     }
 }
 
+/// Issue #21: the same inputs and seed give the same summary.json, byte for byte,
+/// once the measured times (all under `timing`) are set aside. Two demo runs into
+/// the same folder (the façade's `campaign` set names the calibration.toml it read
+/// there), each summary read after its run.
+#[test]
+fn demo_summaries_are_reproducible_apart_from_timing() {
+    let dir = tempfile::tempdir().unwrap();
+    let names = ["one-sided-demo", "two-sided-demo", "facade"];
+    let mut runs = Vec::new();
+    for _ in 0..2 {
+        let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+            .args(["demo", "--fixtures"])
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures"))
+            .arg("--out")
+            .arg(dir.path())
+            .args(["--samples", "3", "--ida-samples", "1", "--scales", "0.5:1.5:3", "--seed", "7"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let read = |n: &str| std::fs::read_to_string(dir.path().join(n).join("summary.json")).unwrap();
+        runs.push(names.map(read));
+    }
+    for (i, name) in names.iter().enumerate() {
+        let (a, b) = (&runs[0][i], &runs[1][i]);
+        let (mut va, mut vb): (Value, Value) = (serde_json::from_str(a).unwrap(), serde_json::from_str(b).unwrap());
+        let ta = va
+            .as_object_mut()
+            .unwrap()
+            .remove("timing")
+            .unwrap_or_else(|| panic!("{name}: no timing"));
+        vb.as_object_mut().unwrap().remove("timing");
+        assert!(
+            ta.as_object().is_some_and(|t| !t.is_empty() && t.values().all(Value::is_number)),
+            "{name}: {ta}"
+        );
+        assert!(
+            !serde_json::to_string(&va).unwrap().contains("wall_s\""),
+            "{name}: a time outside `timing`"
+        );
+        // The bytes without the timing object: the files differ nowhere else.
+        let cut = |s: &str| {
+            let i = s
+                .find("\n  \"timing\": {")
+                .unwrap_or_else(|| panic!("{name}: timing not at the top level"));
+            let j = i + s[i..].find("\n  }").unwrap() + 4;
+            format!("{}{}", &s[..i], &s[j..])
+        };
+        assert_eq!(cut(a), cut(b), "{name}: summary.json differs between two runs");
+        assert_eq!(va, vb, "{name}");
+    }
+    // The façade's fragility came from an IDA: its time is under `timing` too.
+    let facade: Value = serde_json::from_str(&runs[0][2]).unwrap();
+    assert!(facade["timing"]["/fragility/wall_s"].is_number(), "{}", facade["timing"]);
+    assert!(facade["timing"]["/runs/0/solve_wall_s"].is_number());
+}
+
 fn gm_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/ground-motions")
 }
@@ -340,10 +396,12 @@ fn simulate_end_to_end() {
         "impacts",
         "pga_g",
         "pgv_cm_s",
-        "solve_wall_s",
     ] {
         assert!(s.get(k).is_some(), "missing {k}");
     }
+    // Issue #21: the measured time sits under `timing`, nowhere else.
+    assert!(s.get("solve_wall_s").is_none());
+    assert!(s["timing"]["/solve_wall_s"].as_f64().is_some_and(|t| t >= 0.0));
     assert!((s["pga_g"].as_f64().unwrap() - 0.617).abs() < 0.0005);
     assert!((s["pgv_cm_s"].as_f64().unwrap() - 61.32).abs() < 0.01);
     // Issue #12: these assertions used to sit inside `if !overturned`, so a

@@ -345,6 +345,7 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
         let wall = start.elapsed().as_secs_f64();
         let (mut doc, _) = reduce_doc(&res, false)?;
         doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall)?;
+        docs::gather_timing(&mut doc["summary"]);
         doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal)?);
         Ok(doc)
     })?;

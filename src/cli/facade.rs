@@ -88,13 +88,15 @@ fn compute(study: &Study, scales: Option<&[f64]>) -> Result<FacadeResults, Solve
     ));
     let ensemble = (study.samples > 0).then(|| ensembles(study)).transpose()?;
     let ens_samples = ensemble.as_ref().map_or(&[][..], |e| e.1.as_slice());
-    let fragility =
-        fragility_samples(study, scales, ens_samples)?.map(|(source, samples): (String, Vec<SampleRun>)| (source, fragility_by_set(study, &samples)));
+    let drawn = fragility_samples(study, scales, ens_samples)?;
+    let fragility_wall_s = drawn.as_ref().and_then(|d| d.wall_s);
+    let fragility = drawn.map(|d| (d.source, fragility_by_set(study, &d.samples)));
     let ida = scales.map(|sc| ida(study, sc).map(|pts| (sc.to_vec(), pts))).transpose()?;
     Ok(FacadeResults {
         runs,
         ensemble,
         fragility,
+        fragility_wall_s,
         ida,
         wall_s: start.elapsed().as_secs_f64(),
     })
@@ -115,10 +117,18 @@ fn ensembles(study: &Study) -> Result<(Vec<rocklab::facade::EnsembleRow>, Vec<Sa
     Ok((rows, samples))
 }
 
+/// The runs the fragility is fitted to, where they come from, and how long they
+/// took when they were run for it.
+struct FragilityRuns {
+    source: String,
+    samples: Vec<SampleRun>,
+    wall_s: Option<f64>,
+}
+
 /// The runs the fragility is fitted to, and where they come from: an IDA over
 /// `scales` (with the study's IDA samples), else the scale-1 ensembles when there
 /// are two records or more.
-fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[SampleRun]) -> Result<Option<(String, Vec<SampleRun>)>, SolverError> {
+fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[SampleRun]) -> Result<Option<FragilityRuns>, SolverError> {
     if let Some(sc) = scales {
         let n = study.ida_samples;
         let pb = progress(
@@ -128,9 +138,19 @@ fn fragility_samples(study: &Study, scales: Option<&[f64]>, ens_samples: &[Sampl
         let start = Instant::now();
         let samples = run_ida_samples(study, sc, n, &|| pb.inc(1))?;
         pb.finish_and_clear();
-        Ok(Some((ida_source(sc, n, samples.len(), start.elapsed().as_secs_f64()), samples)))
+        let wall = start.elapsed().as_secs_f64();
+        say(&format!("{} fragility runs in {wall:.2} s", samples.len()));
+        Ok(Some(FragilityRuns {
+            source: ida_source(sc, n, samples.len()),
+            samples,
+            wall_s: Some(wall),
+        }))
     } else if !ens_samples.is_empty() && study.records.len() >= 2 {
-        Ok(Some((ensemble_source(ens_samples.len(), study.records.len()), ens_samples.to_vec())))
+        Ok(Some(FragilityRuns {
+            source: ensemble_source(ens_samples.len(), study.records.len()),
+            samples: ens_samples.to_vec(),
+            wall_s: None,
+        }))
     } else {
         Ok(None)
     }

@@ -4,9 +4,10 @@
 
 use rayon::prelude::*;
 
-use super::html;
+use super::html::Page;
 use super::plots::{self, Figure, Panel, Series};
-use super::{tables, Files, InputFile, ReportError};
+use super::tables::{self, to_html, Table};
+use super::{Files, InputFile, ReportError};
 use crate::reduce::{CampaignResult, Reduced};
 use crate::restitution::local_ratios;
 
@@ -38,6 +39,7 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
     if let Some(map) = doc.as_object_mut() {
         map.extend(extra.summary.clone());
     }
+    super::docs::gather_timing(&mut doc);
     files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
     impacts_file(&doc, &mut files)?;
     let tabs = tables::tables(res);
@@ -55,7 +57,7 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
         motion.add_to(&mut files, &format!("plots/{id}_motion"));
         ratios.add_to(&mut files, &format!("plots/{id}_ratios"));
     }
-    let page = html::reduce_page(res, &tabs, &figs, &extra.html_sections, sources);
+    let page = reduce_page(res, &tabs, &figs, &extra.html_sections, sources);
     files.add("report.html", page);
     Ok(files)
 }
@@ -74,7 +76,7 @@ fn impacts_file(doc: &serde_json::Value, files: &mut Files) -> Result<(), Report
 }
 
 /// Each table as `NAME.csv` and `NAME.md`, all of them in tables.md and tables.tex.
-fn table_files(res: &CampaignResult, tabs: &[tables::Table], files: &mut Files) -> Result<(), ReportError> {
+fn table_files(res: &CampaignResult, tabs: &[Table], files: &mut Files) -> Result<(), ReportError> {
     let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
     let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
     for t in tabs {
@@ -142,4 +144,105 @@ fn test_plots(id: &str, r: &Reduced, e_h: f64) -> Result<(Figure, Figure), Repor
     }];
     let ratios_fig = plots::render(&ratios, 800, 400)?;
     Ok((motion_fig, ratios_fig))
+}
+
+/// The reduce report (plus extra sections, e.g. the calibration).
+fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: &[String], sources: &Sources) -> String {
+    let c = &res.campaign;
+    let mut page = Page::new(&format!("{} — coefficients of restitution ({} rocking)", c.name, c.rocking.as_str()));
+    page.p(&format!(
+        "α = {:.4} rad ({}); e_H = {:.4} ({}). Ratios are divided by e_H. Velocity peaks: {}.",
+        c.alpha_rad,
+        c.alpha_source,
+        c.e_housner,
+        c.e_housner_source,
+        res.options.method.describe()
+    ));
+    let failed: Vec<_> = res.failed().collect();
+    if !failed.is_empty() {
+        page.h2("Tests that could not be reduced");
+        page.table(
+            "meta",
+            &["test", "reason"],
+            &failed.iter().map(|(id, e)| vec![id.to_string(), e.to_string()]).collect::<Vec<_>>(),
+        );
+    }
+    page.h2("Tables");
+    if !res.means.left_out.is_empty() {
+        page.p(&format!("Means leave out: {}.", res.means.left_out_text()));
+    }
+    for t in tabs {
+        page.raw(&to_html(t));
+    }
+    page.h2("Velocity peaks");
+    let mut rows = Vec::new();
+    for t in &res.tests {
+        if let Ok(r) = &t.result {
+            rows.push(
+                std::iter::once(t.spec.id.clone())
+                    .chain(r.analysis.peaks.iter().map(|p| format!("{:.1} @ {:.3} s", p.velocity_mm_s, p.time_s)))
+                    .collect(),
+            );
+        }
+    }
+    page.table("meta peaks", &["test", "v0 (mm/s)", "v1", "v2", "v3", "v4", "v5"], &rows);
+    for x in extra {
+        page.raw(x);
+    }
+    page.h2("Plots");
+    for (id, motion, ratios) in figs {
+        page.h3(&format!("Test {id}"));
+        page.figure(
+            &motion.svg,
+            &format!("Test {id}: displacement and velocity with the velocity peaks marked (paper Fig. 3/4)."),
+        );
+        page.figure(&ratios.svg, &format!("Test {id}: local ratios of Eq. 3 and their mean (paper Fig. 5)."));
+    }
+    provenance(&mut page, res, sources);
+    page.finish()
+}
+
+/// The provenance section of the reduce report: the inputs with their checksums,
+/// what reading and fitting each log noted, every warning, the tool, the manifest.
+fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
+    page.h2("Provenance");
+    page.provenance(&sources.files);
+    let mut notes = Vec::new();
+    for t in &res.tests {
+        if let Ok(r) = &t.result {
+            for n in &r.log.notes {
+                notes.push(vec![t.spec.id.clone(), n.clone()]);
+            }
+            if let (Some(p), Some(rms)) = (r.analysis.p_fit, r.analysis.rms_mm) {
+                notes.push(vec![
+                    t.spec.id.clone(),
+                    format!(
+                        "fit: p_e = {p:.4} rad/s, λ = {}, RMS {rms:.4} mm, noise {:.4} mm, spikes removed {}",
+                        r.analysis.lambda_fit.map_or("—".to_string(), |l| format!("{l:.2} s⁻²")),
+                        r.analysis.noise_mm,
+                        r.analysis.spikes_removed
+                    ),
+                ]);
+            }
+        }
+    }
+    page.table("meta", &["test", "reading and fit"], &notes);
+    let warnings: Vec<Vec<String>> = res
+        .tests
+        .iter()
+        .flat_map(|t| t.warnings.iter().map(move |w| vec![t.spec.id.clone(), w.clone()]))
+        .collect();
+    if warnings.is_empty() {
+        page.p("No warnings were raised while reading.");
+    } else {
+        page.raw("<p class=\"warn\">Warnings raised while reading:</p>");
+        page.table("meta", &["test", "warning"], &warnings);
+    }
+    page.p(&format!(
+        "Tool: rocklab {}; method: {}.",
+        env!("CARGO_PKG_VERSION"),
+        res.options.method.describe()
+    ));
+    page.h3("Manifest");
+    page.pre(&sources.manifest);
 }

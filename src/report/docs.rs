@@ -50,7 +50,7 @@ pub fn simulate_summary(
     sim: &Simulation,
 ) -> Result<Value, ReportError> {
     let b = &block.block;
-    Ok(serde_json::to_value(SimulateDoc {
+    let mut doc = serde_json::to_value(SimulateDoc {
         block: &block.name,
         record: record_name,
         record_notes: &record.notes,
@@ -68,7 +68,9 @@ pub fn simulate_summary(
         atol: spec.atol,
         summary,
         events: &sim.events,
-    })?)
+    })?;
+    gather_timing(&mut doc);
+    Ok(doc)
 }
 
 #[derive(Serialize)]
@@ -127,12 +129,15 @@ pub struct EnsembleDoc<'a> {
     pub rows: &'a [EnsembleRow],
 }
 
-/// The fragility section of the façade summary: where the runs came from and the fits.
+/// The fragility section of the façade summary: where the runs came from and the
+/// fits; `wall_s`, how long the fragility's own runs took (an IDA), goes to `timing`.
 #[derive(Serialize)]
 pub struct FragilityDoc<'a> {
     pub im: crate::facade::Im,
     pub source: &'a str,
     pub sets: &'a [SetFragility],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_s: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -163,7 +168,7 @@ pub fn facade_summary(
     ensemble: Option<EnsembleDoc>,
     fragility: Option<FragilityDoc>,
 ) -> Result<Value, ReportError> {
-    Ok(serde_json::to_value(FacadeDoc {
+    let mut doc = serde_json::to_value(FacadeDoc {
         study: &study.name,
         block: &study.block.name,
         alpha_rad: study.block.block.alpha,
@@ -176,5 +181,55 @@ pub fn facade_summary(
         runs,
         ensemble,
         fragility,
-    })?)
+    })?;
+    gather_timing(&mut doc);
+    Ok(doc)
+}
+
+/// The key that holds every measured time of a summary document.
+pub const TIMING: &str = "timing";
+
+/// Move every measured time of a summary document (a key ending in `wall_s`, at any
+/// depth) under one top-level [`TIMING`] object, keyed by its JSON pointer
+/// (`/wall_s`, `/runs/3/solve_wall_s`, `/calibration/wall_s`). The rest of the
+/// document then depends only on the inputs and the seed: two runs give the same
+/// bytes once `timing` is removed. Applied to every summary.json (CLI and Python).
+pub fn gather_timing(doc: &mut Value) {
+    let mut found = serde_json::Map::new();
+    take_timings(doc, "", &mut found);
+    if found.is_empty() {
+        return;
+    }
+    if let Some(map) = doc.as_object_mut() {
+        match map.get_mut(TIMING).and_then(Value::as_object_mut) {
+            Some(t) => t.extend(found),
+            None => {
+                map.insert(TIMING.into(), Value::Object(found));
+            }
+        }
+    }
+}
+
+fn take_timings(v: &mut Value, at: &str, found: &mut serde_json::Map<String, Value>) {
+    match v {
+        Value::Object(map) => {
+            let keys: Vec<String> = map.keys().filter(|k| k.as_str() != TIMING || !at.is_empty()).cloned().collect();
+            for k in keys {
+                let path = format!("{at}/{}", k.replace('~', "~0").replace('/', "~1"));
+                if k.ends_with("wall_s") {
+                    if let Some(t) = map.remove(&k) {
+                        found.insert(path, t);
+                    }
+                } else if let Some(child) = map.get_mut(&k) {
+                    take_timings(child, &path, found);
+                }
+            }
+        }
+        Value::Array(items) => {
+            for (i, item) in items.iter_mut().enumerate() {
+                take_timings(item, &format!("{at}/{i}"), found);
+            }
+        }
+        _ => {}
+    }
 }

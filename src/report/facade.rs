@@ -28,20 +28,22 @@ pub struct FacadeResults {
     /// The IDA's scales and points.
     pub ida: Option<(Vec<f64>, Vec<IdaPoint>)>,
     pub wall_s: f64,
+    /// How long the fragility's own runs (an IDA) took; summary.json's `timing`.
+    pub fragility_wall_s: Option<f64>,
 }
 
 /// The fragility's source when it comes from an IDA over `scales` with `n`
-/// samples per point (`runs` runs in `wall_s` seconds).
-pub fn ida_source(scales: &[f64], n: usize, runs: usize, wall_s: f64) -> String {
+/// samples per point (`runs` runs). No time in it: summary.json keeps times under
+/// `timing`, so that two runs with the same seed give the same document.
+pub fn ida_source(scales: &[f64], n: usize, runs: usize) -> String {
     format!(
-        "IDA over {} scale factors ({:.3}–{:.3} × the magnification), {} sample{} per record × polarity × set at each ({} runs, {:.2} s)",
+        "IDA over {} scale factors ({:.3}–{:.3} × the magnification), {} sample{} per record × polarity × set at each ({} runs)",
         scales.len(),
         scales.first().copied().unwrap_or(f64::NAN),
         scales.last().copied().unwrap_or(f64::NAN),
         n,
         if n == 1 { "" } else { "s" },
-        runs,
-        wall_s
+        runs
     )
 }
 
@@ -83,7 +85,12 @@ pub fn facade_files(study: &Study, res: &FacadeResults, inputs: &[InputFile]) ->
         uncertainty: &study.uncertainty,
         rows,
     });
-    let fragility = res.fragility.as_ref().map(|(source, sets)| FragilityDoc { im: study.im, source, sets });
+    let fragility = res.fragility.as_ref().map(|(source, sets)| FragilityDoc {
+        im: study.im,
+        source,
+        sets,
+        wall_s: res.fragility_wall_s,
+    });
     let doc = facade_summary(study, &res.runs, res.wall_s, ensemble, fragility)?;
     files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
     let md = tables.iter().map(to_markdown).collect::<Vec<_>>().join("\n");

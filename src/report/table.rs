@@ -28,7 +28,7 @@ impl Column {
         Column {
             key: key.into(),
             label: label.into(),
-            tex: Some(super::tables::latex_escape(label)),
+            tex: Some(latex_escape(label)),
             align,
         }
     }
@@ -162,7 +162,6 @@ fn md_cell(c: &Cell) -> String {
 /// HTML: the table with its id, caption, `data-test` on rows and `data-col`,
 /// `data-value`, `data-u` on numeric cells.
 pub fn to_html(t: &Table) -> String {
-    use super::html::escape;
     let wide = if t.nowrap { " wide" } else { "" };
     let id = if t.name.is_empty() {
         String::new()
@@ -193,7 +192,6 @@ pub fn to_html(t: &Table) -> String {
 }
 
 fn html_cell(c: &Column, cell: &Cell, nowrap: bool) -> String {
-    use super::html::escape;
     let mut attrs = String::new();
     let classes: Vec<&str> = cell.class.into_iter().chain((c.align == Align::Left).then_some("l")).collect();
     if !classes.is_empty() {
@@ -219,7 +217,6 @@ fn html_cell(c: &Column, cell: &Cell, nowrap: bool) -> String {
 /// LaTeX (booktabs): caption, label, the columns that have a LaTeX head; mean rows
 /// after a rule. Text is escaped, "±" set as `$\pm$`.
 pub fn to_latex(t: &Table) -> String {
-    use super::tables::latex_escape;
     let cols: Vec<usize> = (0..t.columns.len()).filter(|&i| t.columns[i].tex.is_some()).collect();
     let spec: String = cols.iter().map(|&i| if t.columns[i].align == Align::Right { 'r' } else { 'l' }).collect();
     let note = t.tex_note.as_ref().map_or(String::new(), |n| format!("\\footnotesize{{{n}}}\n  "));
@@ -265,4 +262,30 @@ pub fn to_csv(t: &Table) -> Result<Vec<u8>, ReportError> {
         w.write_record(t.csv.iter().map(|(_, f)| field(f)))?;
     }
     super::csv_bytes(w)
+}
+
+/// Escape text for HTML.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Escape LaTeX's special characters (and spell the Unicode the captions use).
+pub fn latex_escape(s: &str) -> String {
+    let mut o = String::new();
+    for c in s.chars() {
+        match c {
+            '_' | '%' | '&' | '#' | '$' | '{' | '}' => {
+                o.push('\\');
+                o.push(c);
+            }
+            '⁺' => o.push_str("$^+$"),
+            '⁻' => o.push_str("$^-$"),
+            '₁' => o.push_str("$_1$"),
+            'α' => o.push_str("$\\alpha$"),
+            '−' => o.push('-'),
+            '²' => o.push_str("$^2$"),
+            _ => o.push(c),
+        }
+    }
+    o
 }

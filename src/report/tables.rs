@@ -3,7 +3,7 @@
 //! uncertainties, the status), Markdown and HTML in percent rounded like the paper
 //! with a quality column, LaTeX with a dagger on suspect tests.
 
-pub use super::table::{to_csv, to_html, to_latex, to_markdown, Table};
+pub use super::table::{latex_escape, to_csv, to_html, to_latex, to_markdown, Table};
 use super::table::{Align, Cell, Column, CsvField};
 use crate::campaign_means::{CampaignMeans, Means};
 use crate::reduce::CampaignResult;
@@ -272,25 +272,4 @@ fn latex_label(name: &str) -> String {
         "r1" => "$r_1$".into(),
         other => latex_escape(other),
     }
-}
-
-/// Escape LaTeX's special characters (and spell the Unicode the captions use).
-pub fn latex_escape(s: &str) -> String {
-    let mut o = String::new();
-    for c in s.chars() {
-        match c {
-            '_' | '%' | '&' | '#' | '$' | '{' | '}' => {
-                o.push('\\');
-                o.push(c);
-            }
-            '⁺' => o.push_str("$^+$"),
-            '⁻' => o.push_str("$^-$"),
-            '₁' => o.push_str("$_1$"),
-            'α' => o.push_str("$\\alpha$"),
-            '−' => o.push('-'),
-            '²' => o.push_str("$^2$"),
-            _ => o.push(c),
-        }
-    }
-    o
 }

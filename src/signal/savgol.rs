@@ -30,7 +30,7 @@ pub struct SavGol {
 impl SavGol {
     /// `window` odd and ≥ 3, `order` < `window`.
     pub fn new(window: usize, order: usize) -> Result<SavGol, SavGolError> {
-        if window < 3 || window % 2 == 0 {
+        if window < 3 || window.is_multiple_of(2) {
             return Err(SavGolError::Window { window });
         }
         if order >= window {

@@ -67,7 +67,7 @@ fn to_python<'py>(py: Python<'py>, doc: Value, series: Series) -> PyResult<(Stri
 
 /// f64 values from little-endian bytes (the package sends `ndarray.tobytes()`).
 fn f64s(name: &str, b: &[u8]) -> anyhow::Result<Vec<f64>> {
-    if b.len() % 8 != 0 {
+    if !b.len().is_multiple_of(8) {
         bail!("{name}: {} bytes is not a whole number of float64 values", b.len());
     }
     Ok(b.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())

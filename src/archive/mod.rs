@@ -33,6 +33,8 @@ pub enum ArchiveError {
     Table { path: PathBuf, message: String },
     #[error("SQL: {0}")]
     Sql(String),
+    #[error("{0}")]
+    Write(String),
     #[error("archive page: {0}")]
     Page(String),
 }
@@ -190,16 +192,20 @@ pub fn add_with_hook(archive: &Path, report_dirs: &[PathBuf], hook: &mut dyn FnM
 /// Stage both tables, commit, rename them into place (see the module docs).
 fn commit(archive: &Path, tables: &mut [(&str, DataFrame)], hook: &mut dyn FnMut(Step) -> Result<(), ArchiveError>) -> Result<(), ArchiveError> {
     let pending = archive.join(PENDING);
-    std::fs::create_dir_all(&pending).map_err(io(&pending))?;
+    // The project's one writer (each file atomically: a temporary, then a rename).
+    let write = |files: &crate::report::Files| crate::report::write_files(&pending, files).map_err(|e| ArchiveError::Write(e.to_string()));
+    let mut staged = crate::report::Files::default();
     for (name, df) in tables.iter_mut() {
-        let path = table_path(&pending, name);
-        let mut bytes = Vec::new();
-        ParquetWriter::new(&mut bytes).finish(df).map_err(table_err(&path))?;
-        crate::atomic::write_atomic(&path, &bytes).map_err(io(&path))?;
+        staged.add(
+            format!("{name}.parquet"),
+            crate::report::parquet::bytes(df).map_err(|e| ArchiveError::Write(e.to_string()))?,
+        );
     }
+    write(&staged)?;
     hook(Step::Staged)?;
-    let marker = pending.join(COMMIT);
-    crate::atomic::write_atomic(&marker, b"both tables staged\n").map_err(io(&marker))?;
+    let mut marker = crate::report::Files::default();
+    marker.add(COMMIT, "both tables staged\n");
+    write(&marker)?;
     for (i, (name, _)) in tables.iter().enumerate() {
         let staged = table_path(&pending, name);
         std::fs::rename(&staged, table_path(archive, name)).map_err(io(&staged))?;

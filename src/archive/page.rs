@@ -126,7 +126,7 @@ pub fn render(tests: &DataFrame) -> Result<String, ArchiveError> {
 
 /// Write `archive.html` (atomically).
 pub fn write(archive: &Path, tests: &DataFrame) -> Result<(), ArchiveError> {
-    let html = render(tests)?;
-    let path = archive.join("archive.html");
-    crate::atomic::write_atomic(&path, html.as_bytes()).map_err(|source| ArchiveError::Io { path, source })
+    let mut files = crate::report::Files::default();
+    files.add("archive.html", render(tests)?);
+    crate::report::write_files(archive, &files).map_err(|e| ArchiveError::Write(e.to_string()))
 }

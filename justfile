@@ -25,10 +25,12 @@ demo:
 bench:
     cargo bench --bench ingest_peaks
 
-# Peak memory of the whole `reduce` command on the benchmark's 2,000,000-row log.
+# Peak memory of the whole `reduce` command on the benchmark's 2,000,000-row log,
+# and on the same rows with 16 channels (242 MB; issue 22 bounds it at 150 MB).
 bench-mem: bench
     cargo build --release
     /usr/bin/time -v target/release/rocklab reduce target/bench-data/campaign.toml --out target/bench-data/out --no-plots 2>&1 | grep -E "Maximum resident|Elapsed"
+    /usr/bin/time -v target/release/rocklab reduce target/bench-data/campaign_wide.toml --out target/bench-data/out_wide --no-plots 2>&1 | grep -E "Maximum resident|Elapsed"
 
 # The Python package (python/): release build and install, as the README says.
 python-install:

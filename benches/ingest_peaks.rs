@@ -4,8 +4,11 @@
 //!
 //! `cargo bench --bench ingest_peaks` prints divan's median. The log and a manifest
 //! are left in `target/bench-data/` so that peak memory can be measured on the
-//! whole command: `just bench-mem`.
+//! whole command: `just bench-mem`. Beside them, `log2m_wide.csv` (the same rows
+//! with 14 extra channels: 16 columns, 242 MB) and `campaign_wide.toml`, for the
+//! memory bound of issue 22 (≤ 150 MB peak to reduce it).
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use rocklab::ingest::{Campaign, Rocking};
@@ -35,7 +38,7 @@ impl Noise {
 /// Two-sided linearised rocking sampled at 1 kHz (10 sub-steps per sample).
 fn write_bench_data(dir: &Path) {
     let log = dir.join("log2m.csv");
-    if log.exists() {
+    if log.exists() && dir.join("log2m_wide.csv").exists() {
         return;
     }
     std::fs::create_dir_all(dir).unwrap();
@@ -45,6 +48,10 @@ fn write_bench_data(dir: &Path) {
     let mut noise = Noise(0x9E3779B97F4A7C15);
     let mut out = String::with_capacity(2_000_000 * 24);
     out.push_str("# generated benchmark log\ntime_s,disp_mm,acc_g\n");
+    let mut wide = std::io::BufWriter::new(std::fs::File::create(dir.join("log2m_wide.csv")).unwrap());
+    let mut channels = Noise(0x2545F4914F6CDD1D);
+    let extra: Vec<String> = (1..=14).map(|k| format!(",ch{k:02}")).collect();
+    writeln!(wide, "# generated benchmark log, 16 channels\ntime_s,disp_mm,acc_g{}", extra.concat()).unwrap();
     let dt = 1e-3;
     for i in 0..2_000_000u64 {
         let t = i as f64 * dt;
@@ -65,8 +72,17 @@ fn write_bench_data(dir: &Path) {
             }
         }
         let x = lever * theta.sin() + 0.04 * (noise.next() + noise.next() + noise.next());
-        out.push_str(&format!("{t:.3},{:.2},0\n", (x * 100.0).round() / 100.0));
+        let row = format!("{t:.3},{:.2},0", (x * 100.0).round() / 100.0);
+        out.push_str(&row);
+        out.push('\n');
+        // 14 channels of noise, 7-8 characters each (a wide DAQ export).
+        write!(wide, "{row}").unwrap();
+        for _ in 0..14 {
+            write!(wide, ",{:.4}", 2.0 * channels.next()).unwrap();
+        }
+        writeln!(wide).unwrap();
     }
+    wide.flush().unwrap();
     std::fs::write(&log, out).unwrap();
     let manifest = r#"[campaign]
 name = "bench"
@@ -83,6 +99,13 @@ id = "log2m"
 file = "log2m.csv"
 "#;
     std::fs::write(dir.join("campaign.toml"), manifest).unwrap();
+    std::fs::write(
+        dir.join("campaign_wide.toml"),
+        manifest
+            .replace("log2m.csv", "log2m_wide.csv")
+            .replace("name = \"bench\"", "name = \"bench-wide\""),
+    )
+    .unwrap();
 }
 
 #[divan::bench(sample_count = 10)]

@@ -1,8 +1,40 @@
 //! Atomic file output: write to a temporary file in the same folder, then rename,
-//! so a reader never sees a half-written file.
+//! so a reader never sees a half-written file. [`write_under`] also refuses a
+//! relative path that would leave its root (issue 22: defence in depth behind
+//! the sanitised names of the report's `file_stem`).
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Component, Path};
+
+/// Why `rel` cannot be written under an output folder, if it cannot: it must be
+/// relative, made of plain names only (no `..`, `.`, root or prefix), none
+/// holding NUL nor longer than 255 bytes.
+pub fn check_relative(rel: &Path) -> Result<(), String> {
+    if rel.as_os_str().is_empty() {
+        return Err("empty path".into());
+    }
+    for c in rel.components() {
+        match c {
+            Component::Normal(n) => {
+                let n = n.to_string_lossy();
+                if n.contains('\0') {
+                    return Err("a NUL byte in the name".into());
+                }
+                if n.len() > 255 {
+                    return Err(format!("a name of {} bytes (at most 255)", n.len()));
+                }
+            }
+            _ => return Err("the path would leave the output folder (expected plain names, no '..', '.' or root)".into()),
+        }
+    }
+    Ok(())
+}
+
+/// Write `bytes` to `root/rel` atomically, after [`check_relative`] of `rel`.
+pub fn write_under(root: &Path, rel: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    check_relative(rel).map_err(|why| std::io::Error::new(std::io::ErrorKind::InvalidInput, why))?;
+    write_atomic(&root.join(rel), bytes)
+}
 
 /// Write `bytes` to `path` atomically (temporary sibling, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -36,5 +68,18 @@ mod tests {
         assert_eq!(std::fs::read(&p).unwrap(), b"two");
         let n = std::fs::read_dir(p.parent().unwrap()).unwrap().count();
         assert_eq!(n, 1, "a temporary file was left behind");
+    }
+
+    // issue 22: a path that leaves the root is refused and nothing is written.
+    #[test]
+    fn refuses_paths_that_leave_the_root() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("out");
+        for bad in ["../x.png", "/tmp/x.png", "plots/../../x", "./x", "a\0b", ""] {
+            assert!(write_under(&root, Path::new(bad), b"x").is_err(), "{bad:?}");
+        }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        write_under(&root, Path::new("plots/a.svg"), b"x").unwrap();
+        assert!(root.join("plots/a.svg").exists());
     }
 }

@@ -113,13 +113,15 @@ fn place(file: &std::path::Path, line: Option<usize>, column: Option<usize>) -> 
 }
 
 impl FileError {
-    /// An invalid value of `file` (not yet located: see [`FileError::located`]).
+    /// An invalid value of `file` (not yet located: see [`FileError::located`]);
+    /// the message is cut to 400 characters (issue 22: a key or a value of any
+    /// length may be quoted in it).
     pub fn invalid(file: &std::path::Path, message: impl std::fmt::Display) -> FileError {
         FileError::Invalid {
             file: file.to_path_buf(),
             line: None,
             column: None,
-            message: message.to_string(),
+            message: excerpt_text(&message.to_string(), 400),
         }
     }
 
@@ -191,6 +193,27 @@ fn locate(text: &str, message: &str) -> Option<(usize, usize)> {
             Some((i + 1, indent + 1))
         }
         _ => None,
+    }
+}
+
+/// At most `max` characters of `value` for a message, with "…" and the full
+/// length when it was cut (issue 22: a bad cell of 8 MB or a whole nested TOML
+/// line is not quoted whole); control characters are shown escaped.
+pub fn excerpt(value: &str, max: usize) -> String {
+    let n = value.chars().count();
+    let shown: String = value.chars().take(max).flat_map(char::escape_debug).collect();
+    if n > max {
+        format!("{shown}… ({n} characters)")
+    } else {
+        shown
+    }
+}
+
+/// At most `max` characters of a message (newlines kept), with "…" when cut.
+pub fn excerpt_text(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        Some((i, _)) => format!("{}… ({} characters)", &text[..i], text.chars().count()),
+        None => text.to_string(),
     }
 }
 

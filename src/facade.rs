@@ -219,20 +219,21 @@ pub fn run_study(study: &Study, scale: f64, with_history: bool, tick: &(dyn Fn()
 
 /// A `--scales` text that is not FROM:TO:N.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("--scales {0}: expected FROM:TO:N with 0 < FROM < TO and N ≥ 2 (e.g. 0.1:2.0:50)")]
+#[error("--scales {0}: expected FROM:TO:N with 0.001 ≤ FROM < TO ≤ 100 and 2 ≤ N ≤ 1000 (e.g. 0.1:2.0:50)")]
 pub struct ScalesError(pub String);
 
 /// Scale factors FROM:TO:N (inclusive, N ≥ 2).
 pub fn parse_scales(s: &str) -> Result<Vec<f64>, ScalesError> {
     let parts: Vec<&str> = s.split(':').collect();
-    let err = || ScalesError(s.to_string());
+    let err = || ScalesError(crate::error::excerpt(s, 60));
     if parts.len() != 3 {
         return Err(err());
     }
     let from: f64 = parts[0].parse().map_err(|_| err())?;
     let to: f64 = parts[1].parse().map_err(|_| err())?;
     let n: usize = parts[2].parse().map_err(|_| err())?;
-    if !(from > 0.0 && to > from && n >= 2 && from.is_finite() && to.is_finite()) {
+    let m = crate::limits::MAGNIFICATION;
+    if !(m.contains(from) && m.contains(to) && to > from && (2..=crate::limits::MAX_SCALES).contains(&n)) {
         return Err(err());
     }
     Ok((0..n).map(|i| from + (to - from) * i as f64 / (n - 1) as f64).collect())

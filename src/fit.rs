@@ -183,6 +183,10 @@ pub fn least_squares(q0: &[f64], steps: &[f64], max_iter: usize, residuals: &Res
     })
 }
 
+/// Iterations of the SVD behind a pseudo-inverse before it gives up: a
+/// well-posed n × n problem (n ≤ 10 here) converges in a few n iterations.
+pub const SVD_MAX_ITERATIONS: usize = 1000;
+
 /// (JᵀJ)⁻¹, or its pseudo-inverse (singular values below 10⁻¹² of the largest
 /// dropped) when the inverse is singular or not finite.
 fn covariance(jtj: DMatrix<f64>) -> Option<DMatrix<f64>> {
@@ -190,8 +194,15 @@ fn covariance(jtj: DMatrix<f64>) -> Option<DMatrix<f64>> {
     if let Some(inv) = jtj.clone().try_inverse().filter(finite) {
         return Some(inv);
     }
+    if !finite(&jtj) {
+        return None;
+    }
     let scale = jtj.diagonal().iter().fold(0.0f64, |a, b| a.max(b.abs()));
-    jtj.pseudo_inverse(1e-12 * scale.max(1e-300)).ok().filter(finite)
+    // nalgebra's `pseudo_inverse` runs an SVD without an iteration limit (issue 22:
+    // a log whose time was scaled by 10⁻⁶ hung in it); `try_svd` stops after
+    // SVD_MAX_ITERATIONS and the covariance is then unknown (None).
+    let svd = jtj.try_svd(true, true, f64::EPSILON, SVD_MAX_ITERATIONS)?;
+    svd.pseudo_inverse(1e-12 * scale.max(1e-300)).ok().filter(finite)
 }
 
 #[cfg(test)]

@@ -69,6 +69,10 @@ pub enum FragilityError {
     Decreasing { b: f64 },
     #[error("Newton's method did not converge in {0} iterations")]
     NoConvergence(usize),
+    /// issue 22: a fit whose 95 % interval is unbounded (the observed information
+    /// is near singular: the runs barely pin the curve) is not a result.
+    #[error("the fit is not identified by these runs (median {median:.4}, β {beta:.4}, but a 95 % interval is unbounded): more records or scales are needed")]
+    Unbounded { median: f64, beta: f64 },
 }
 
 /// ln Φ(η) and ln(1 − Φ(η)), with η clamped to ±35 (beyond, the terms are
@@ -198,6 +202,20 @@ pub fn fit_lognormal(trials: &[Trial]) -> Result<Fragility, FragilityError> {
     let var_lb = j11 * j11 * cbb;
     let (se_mu, se_lb) = (var_mu.max(0.0).sqrt(), var_lb.max(0.0).sqrt());
     let (median, beta) = ((-a / b).exp(), 1.0 / b);
+    let bounded = [
+        median,
+        beta,
+        se_mu,
+        se_lb,
+        median * (Z95 * se_mu).exp(),
+        beta * (Z95 * se_lb).exp(),
+        median * (-Z95 * se_mu).exp(),
+    ]
+    .iter()
+    .all(|v| v.is_finite() && *v > 0.0);
+    if !bounded {
+        return Err(FragilityError::Unbounded { median, beta });
+    }
     Ok(Fragility {
         median,
         beta,

@@ -40,6 +40,7 @@ pub mod fit;
 pub mod fragility;
 pub mod ground_motion;
 pub mod ingest;
+pub mod limits;
 pub mod outcomes;
 pub mod peaks;
 pub mod reduction;

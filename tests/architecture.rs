@@ -17,6 +17,7 @@ const CORE: &[&str] = &[
     "src/facade.rs",
     "src/fit.rs",
     "src/fragility.rs",
+    "src/limits.rs",
     "src/outcomes.rs",
     "src/ground_motion",
     "src/peaks",

@@ -59,7 +59,7 @@ pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, 
         ));
     }
     for (id, e) in &cal.failed {
-        eprintln!("test {id}: {e}");
+        super::tell(&format!("test {id}: {e}"));
     }
     say(&format!("wrote {}", out.display()));
     Ok(cal)

@@ -42,6 +42,15 @@ pub struct EnsembleArgs {
 }
 
 impl EnsembleArgs {
+    /// Sizes within [`rocklab::limits::MAX_SAMPLES`] (issue 22: ensembles bounded).
+    pub fn check(&self) -> anyhow::Result<()> {
+        for (flag, n) in [("--samples", self.samples), ("--ida-samples", self.ida_samples)] {
+            if let Some(n) = n.filter(|n| *n > rocklab::limits::MAX_SAMPLES) {
+                anyhow::bail!("{flag} {n}: expected at most {}", rocklab::limits::MAX_SAMPLES);
+            }
+        }
+        Ok(())
+    }
     pub fn apply(&self, study: &mut Study) {
         if let Some(n) = self.samples {
             study.samples = n;
@@ -57,6 +66,7 @@ impl EnsembleArgs {
 
 pub fn run(a: FacadeArgs) -> anyhow::Result<ExitCode> {
     let mut study = Study::load(&a.study)?;
+    a.ensemble.check()?;
     a.ensemble.apply(&mut study);
     let scales = a.scales.as_deref().map(parse_scales).transpose()?;
     run_and_write(&study, scales.as_deref(), &a.out)?;

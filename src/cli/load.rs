@@ -10,7 +10,7 @@ use rocklab::report::InputFile;
 
 /// One input file as read now.
 pub fn input(role: &str, path: &Path) -> InputFile {
-    InputFile::new(role, path, std::fs::read(path))
+    InputFile::from_reader(role, path, std::fs::File::open(path))
 }
 
 /// The manifest (its text and facts) and every test's log.

@@ -110,6 +110,12 @@ pub fn say(line: &str) {
     let _ = writeln!(out, "{line}");
 }
 
+/// Print a line to stderr, cut at 4,000 characters (issue 22: a message may quote
+/// an input's path or id, of any length).
+pub fn tell(line: &str) {
+    eprintln!("{}", rocklab::error::excerpt_text(line, 4000));
+}
+
 /// A progress bar on stderr when it is a terminal; hidden otherwise (pipes, CI).
 pub fn progress(n: usize, what: &str) -> indicatif::ProgressBar {
     use std::io::IsTerminal;

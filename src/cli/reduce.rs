@@ -53,7 +53,7 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
     pb.finish_and_clear();
     for t in &res.tests {
         for w in &t.warnings {
-            eprintln!("warning: test {}: {w}", t.spec.id);
+            super::tell(&format!("warning: test {}: {w}", t.spec.id));
         }
     }
     say(&tables::to_markdown(&tables::tables(&res)[0]));
@@ -62,14 +62,17 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
     }
     for t in &res.tests {
         if let Some(why) = t.result.as_ref().ok().and_then(|r| r.suspect_reason()) {
-            eprintln!("suspect: test {}: {why} (its values are printed but left out of the means)", t.spec.id);
+            super::tell(&format!(
+                "suspect: test {}: {why} (its values are printed but left out of the means)",
+                t.spec.id
+            ));
         }
     }
     let failed: Vec<_> = res.failed().collect();
     if !failed.is_empty() {
-        eprintln!("{} of {} tests failed:", failed.len(), res.tests.len());
+        super::tell(&format!("{} of {} tests failed:", failed.len(), res.tests.len()));
         for (id, e) in failed {
-            eprintln!("  test {id}: {e}");
+            super::tell(&format!("  test {id}: {e}"));
         }
     }
     res

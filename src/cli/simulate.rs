@@ -119,15 +119,20 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
     if a.polarity != 1 && a.polarity != -1 {
         bail!("--polarity {}: expected 1 or -1", a.polarity);
     }
-    if !(a.scale.is_finite() && a.scale > 0.0) {
-        bail!("--scale {}: expected a positive number", a.scale);
-    }
+    use rocklab::limits;
+    let flag = |name: &str, v: f64, r: limits::Range| r.check(name, v).map_err(anyhow::Error::msg);
+    flag("--scale", a.scale, limits::MAGNIFICATION)?;
+    flag("--rtol", a.rtol, limits::RTOL)?;
+    flag("--atol", a.atol, limits::ATOL)?;
+    flag("--t-extra", a.t_extra, limits::T_EXTRA_S)?;
+    let overturn_limit = a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha);
+    flag("overturn limit (rad)", overturn_limit, limits::ANGLE_RAD)?;
     Ok(RunSpec {
         e_in,
         e_out,
         scale: a.scale,
         polarity: a.polarity as f64,
-        overturn_limit: a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha),
+        overturn_limit,
         t_extra: a.t_extra,
         rtol: a.rtol,
         atol: a.atol,

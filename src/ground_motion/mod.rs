@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::InputError;
+use crate::limits;
 use crate::G;
 
 /// Acceleration units.
@@ -108,11 +109,13 @@ pub struct ReadOptions {
     pub units: Option<Units>,
 }
 
+/// A defect at a line; the message is cut to 300 characters (issue 22: it may
+/// quote a header line or a token of any length).
 fn err(path: &Path, line: usize, message: impl Into<String>) -> InputError {
     InputError::Line {
         file: path.to_path_buf(),
         line: line as u64,
-        message: message.into(),
+        message: crate::error::excerpt_text(&message.into(), 300),
     }
 }
 
@@ -220,7 +223,36 @@ pub fn parse(path: &Path, text: &str, opts: &ReadOptions) -> Result<Record, Inpu
         *a *= k;
     }
     rec.units = units;
+    check_ranges(path, &rec)?;
     Ok(rec)
+}
+
+/// The record within the physical ranges of [`crate::limits`] (issue 22: a sample
+/// of 10³⁰ g or a record scaled by 10³⁰⁰ made the solver retry without end).
+fn check_ranges(path: &Path, rec: &Record) -> Result<(), InputError> {
+    let fail = |message: String| {
+        Err(InputError::File {
+            file: path.to_path_buf(),
+            message,
+        })
+    };
+    if !limits::RECORD_DT_S.contains(rec.dt) {
+        return fail(format!("time step {} s: expected a value {}", rec.dt, limits::RECORD_DT_S.describe()));
+    }
+    if rec.acc_m_s2.len() > limits::RECORD_SAMPLES {
+        return fail(format!("{} samples: expected at most {}", rec.acc_m_s2.len(), limits::RECORD_SAMPLES));
+    }
+    let max = limits::RECORD_ACCEL_G.hi * G;
+    if let Some((i, a)) = rec.acc_m_s2.iter().enumerate().find(|(_, a)| a.abs() > max) {
+        return fail(format!(
+            "sample {} (t = {} s) is {:e} g: expected |a| ≤ {} g (wrong units? pass --units)",
+            i + 1,
+            rec.t0 + i as f64 * rec.dt,
+            a / G,
+            limits::RECORD_ACCEL_G.hi
+        ));
+    }
+    Ok(())
 }
 
 /// Numbers of a line; Fortran fields that run together ("-.12E-03-.34E-03") are
@@ -230,9 +262,12 @@ fn numbers(line: &str) -> Result<Vec<f64>, String> {
     let mut tok = String::new();
     let flush = |tok: &mut String, out: &mut Vec<f64>| -> Result<(), String> {
         if !tok.is_empty() {
-            let v: f64 = tok.replace(['D', 'd'], "E").parse().map_err(|_| format!("'{tok}' is not a number"))?;
+            let v: f64 = tok
+                .replace(['D', 'd'], "E")
+                .parse()
+                .map_err(|_| format!("'{}' is not a number", crate::error::excerpt(tok, 60)))?;
             if !v.is_finite() {
-                return Err(format!("'{tok}' is not a finite number"));
+                return Err(format!("'{}' is not a finite number", crate::error::excerpt(tok, 60)));
             }
             out.push(v);
             tok.clear();

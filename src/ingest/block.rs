@@ -31,6 +31,7 @@ use serde::Deserialize;
 
 use crate::error::{FileError, FileKind};
 use crate::ingest::text::{parse_toml, read_text};
+use crate::limits;
 pub use crate::solver::block::{BlockSpec, ImpactDefaults};
 use crate::solver::{Block, Restraint, TieRod};
 use crate::wall::Rectangle;
@@ -79,33 +80,30 @@ type RawImpact = ImpactDefaults;
 
 type Result<T> = std::result::Result<T, FileError>;
 
-fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(FileError::invalid(path, format!("{key} = {v}: expected a positive number")))
-    }
+/// `v` within its physical range (issue 22: [`crate::limits`]).
+fn within(path: &Path, key: &str, v: f64, range: limits::Range) -> Result<f64> {
+    range.check(key, v).map_err(|m| FileError::invalid(path, m))
 }
 
 /// The rectangular block with the overrides of R, α, I_0 and mass, and which were
 /// given.
 fn block(b: &RawBlock, path: &Path) -> Result<(Block, Vec<String>)> {
     let geom = Rectangle::new(
-        positive(path, "[block].height_m", b.height_m)?,
-        positive(path, "[block].thickness_m", b.thickness_m)?,
+        within(path, "[block].height_m", b.height_m, limits::LENGTH_M)?,
+        within(path, "[block].thickness_m", b.thickness_m, limits::LENGTH_M)?,
     );
     let mut block = Block::rectangular(
         geom,
-        positive(path, "[block].width_m", b.width_m)?,
-        positive(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3)?,
+        within(path, "[block].width_m", b.width_m, limits::LENGTH_M)?,
+        within(path, "[block].unit_weight_kn_m3", b.unit_weight_kn_m3, limits::UNIT_WEIGHT_KN_M3)?,
     );
     let mut overrides = Vec::new();
     if let Some(m) = b.mass_kg {
-        block.mass_kg = positive(path, "[block].mass_kg", m)?;
+        block.mass_kg = within(path, "[block].mass_kg", m, limits::MASS_KG)?;
         overrides.push("mass_kg".into());
     }
     if let Some(r) = b.r_m {
-        block.r_m = positive(path, "[block].r_m", r)?;
+        block.r_m = within(path, "[block].r_m", r, limits::LENGTH_M)?;
         overrides.push("r_m".into());
     }
     if let Some(a) = b.alpha_rad {
@@ -119,7 +117,18 @@ fn block(b: &RawBlock, path: &Path) -> Result<(Block, Vec<String>)> {
     block.i0 = match b.i0_kg_m2 {
         Some(i) => {
             overrides.push("i0_kg_m2".into());
-            positive(path, "[block].i0_kg_m2", i)?
+            let m_r2 = block.mass_kg * block.r_m * block.r_m;
+            within(path, "[block].i0_kg_m2 / (m R²)", i / m_r2, limits::I0_OVER_M_R2).map_err(|_| {
+                FileError::invalid(
+                    path,
+                    format!(
+                        "[block].i0_kg_m2 = {}: expected a value from {m_r2:.4e} to {:.4e} kg m² (1 to 10 × m R²)",
+                        limits::show(i),
+                        10.0 * m_r2
+                    ),
+                )
+            })?;
+            i
         }
         None => Block::rectangular_i0(block.mass_kg, block.r_m),
     };
@@ -134,12 +143,15 @@ fn restraint(r: Option<&RawRestraint>, path: &Path) -> Result<(Restraint, Option
     };
     match (r.unit_stiffness_mn_m2, r.contact_height_m, r.rotational_stiffness_mnm_rad) {
         (Some(k), Some(h), None) => Ok((
-            Restraint::spring_bed(positive(path, "unit_stiffness_mn_m2", k)? * 1e6, positive(path, "contact_height_m", h)?),
+            Restraint::spring_bed(
+                within(path, "[restraint].unit_stiffness_mn_m2", k, limits::STIFFNESS)? * 1e6,
+                within(path, "[restraint].contact_height_m", h, limits::LENGTH_M)?,
+            ),
             Some((k, h)),
         )),
         (None, None, Some(k)) => Ok((
             Restraint::Rotational {
-                k_nm_per_rad: positive(path, "rotational_stiffness_mnm_rad", k)? * 1e6,
+                k_nm_per_rad: within(path, "[restraint].rotational_stiffness_mnm_rad", k, limits::STIFFNESS)? * 1e6,
             },
             None,
         )),
@@ -152,11 +164,11 @@ fn restraint(r: Option<&RawRestraint>, path: &Path) -> Result<(Restraint, Option
 
 fn tie_rod(t: &RawTie, path: &Path) -> Result<TieRod> {
     Ok(TieRod {
-        stiffness_n_m: positive(path, "[[tie_rod]].stiffness_kn_m", t.stiffness_kn_m)? * 1e3,
-        height_m: positive(path, "[[tie_rod]].height_m", t.height_m)?,
+        stiffness_n_m: within(path, "[[tie_rod]].stiffness_kn_m", t.stiffness_kn_m, limits::STIFFNESS)? * 1e3,
+        height_m: within(path, "[[tie_rod]].height_m", t.height_m, limits::LENGTH_M)?,
         yield_force_n: t
             .yield_force_kn
-            .map(|f| positive(path, "[[tie_rod]].yield_force_kn", f).map(|v| v * 1e3))
+            .map(|f| within(path, "[[tie_rod]].yield_force_kn", f, limits::STIFFNESS).map(|v| v * 1e3))
             .transpose()?,
     })
 }

@@ -7,10 +7,18 @@
 //! file. Every defect is an [`InputError`] naming the file, line and column.
 //! Logs in the loggers' own formats (.xlsx, .tdms, .mat, .parquet, by extension)
 //! are handed to `ingest::formats` by [`LogReader::read`].
+//!
+//! Memory (issue 22): the file is streamed, never held whole. The format is
+//! detected on its first [`PREFIX_BYTES`], then the csv reader runs over that
+//! prefix chained with the rest of the file, and only the two columns used (time
+//! and displacement) are kept, reserved by an estimate of the rows from the file's
+//! size and the width of its first rows. A 16-channel 2,000,000-row log (242 MB)
+//! reduces in about the memory of its two columns (docs/hardening.md).
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use crate::error::InputError;
+use crate::error::{excerpt, InputError};
 pub use crate::reduction::LogData;
 
 /// Field delimiter of a log.
@@ -112,12 +120,27 @@ impl LogReader {
         self
     }
 
-    /// Read the file.
+    /// Read the file, streamed (see the module docs).
     pub fn read(&self) -> Result<LogData, InputError> {
         if let Some(kind) = crate::ingest::formats::Kind::of(&self.path) {
             return crate::ingest::formats::read(kind, &self.request());
         }
-        self.parse(&crate::ingest::text::read_bytes(&self.path)?)
+        let io = |source| InputError::Io {
+            file: self.path.clone(),
+            source,
+        };
+        let f = std::fs::File::open(&self.path).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::NotFound {
+                InputError::Missing { file: self.path.clone() }
+            } else {
+                io(e)
+            }
+        })?;
+        let size = f.metadata().map(|m| m.len()).unwrap_or(0);
+        let mut f = std::io::BufReader::with_capacity(1 << 16, f);
+        let mut prefix = Vec::new();
+        (&mut f).take(PREFIX_BYTES as u64).read_to_end(&mut prefix).map_err(io)?;
+        self.parse_stream(&prefix, f, size)
     }
 
     /// What a structured-format reader needs (`ingest::formats`).
@@ -134,9 +157,16 @@ impl LogReader {
 
     /// Parse the bytes of a log (the path only names it in messages).
     pub fn parse(&self, bytes: &[u8]) -> Result<LogData, InputError> {
+        self.parse_stream(bytes, std::io::empty(), bytes.len() as u64)
+    }
+
+    /// Parse a log whose first bytes are `prefix` and the rest `rest`; `size` is
+    /// the whole length (for the reservation only).
+    fn parse_stream(&self, prefix: &[u8], rest: impl Read, size: u64) -> Result<LogData, InputError> {
         let file = &self.path;
-        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-        if bytes.iter().all(|b| b.is_ascii_whitespace()) {
+        let bytes = prefix.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(prefix);
+        let mut rest = LastByte { inner: rest, last: None };
+        if bytes.iter().all(|b| b.is_ascii_whitespace()) && size <= prefix.len() as u64 {
             return Err(InputError::Empty { file: file.clone() });
         }
         let mut data = LogData::default();
@@ -147,15 +177,18 @@ impl LogReader {
             .flexible(true)
             .comment(Some(b'#'))
             .trim(csv::Trim::All)
-            .from_reader(bytes);
+            .from_reader(bytes.chain(&mut rest));
         let mut rec = csv::ByteRecord::new();
         let cols = self.header(&mut rdr, &mut rec, bytes)?;
-        let approx_rows = bytes.len() / 16;
+        let approx_rows = approx_rows(bytes, size);
         data.time_s.reserve(approx_rows);
         data.disp_mm.reserve(approx_rows);
-        if let Some((line, e)) = self.rows(&mut rdr, &mut rec, &cols, decimal, &mut data)? {
+        let defect = self.rows(&mut rdr, &mut rec, &cols, decimal, &mut data)?;
+        drop(rdr);
+        let last = rest.last.or_else(|| bytes.last().copied());
+        if let Some((line, e)) = defect {
             // A defect on a last line without a line end: the export was cut off.
-            if bytes.last().is_some_and(|b| *b == b'\n' || *b == b'\r') {
+            if last.is_some_and(|b| b == b'\n' || b == b'\r') {
                 return Err(e);
             }
             data.warnings.push(format!(
@@ -170,11 +203,36 @@ impl LogReader {
                 line: cols.header_line,
             });
         }
+        data.time_s.shrink_to_fit();
+        data.disp_mm.shrink_to_fit();
+        self.check_rate(&data)?;
         Ok(data)
     }
 
+    /// The mean sampling rate within [`crate::limits::LOG_RATE_HZ`] (issue 22: a
+    /// time column scaled by 10⁻⁶ made a fit run without end).
+    fn check_rate(&self, data: &LogData) -> Result<(), InputError> {
+        let (n, t) = (data.time_s.len(), &data.time_s);
+        if n < 2 {
+            return Ok(());
+        }
+        let rate = (n - 1) as f64 / (t[n - 1] - t[0]);
+        let range = crate::limits::LOG_RATE_HZ;
+        if range.contains(rate) {
+            return Ok(());
+        }
+        Err(InputError::File {
+            file: self.path.clone(),
+            message: format!(
+                "column '{}': a mean sampling rate of {rate:.6e} Hz: expected a rate {} (is [channels].time.unit right?)",
+                excerpt(&self.time_column, 60),
+                range.describe()
+            ),
+        })
+    }
+
     /// The next record, or false at the end.
-    fn next_record(&self, rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord) -> Result<bool, InputError> {
+    fn next_record<R: Read>(&self, rdr: &mut csv::Reader<R>, rec: &mut csv::ByteRecord) -> Result<bool, InputError> {
         rdr.read_byte_record(rec).map_err(|e| InputError::File {
             file: self.path.clone(),
             message: format!("not readable as delimited text: {e}"),
@@ -182,7 +240,7 @@ impl LogReader {
     }
 
     /// Read the header row and find the time and displacement columns.
-    fn header(&self, rdr: &mut csv::Reader<&[u8]>, rec: &mut csv::ByteRecord, bytes: &[u8]) -> Result<Columns, InputError> {
+    fn header<R: Read>(&self, rdr: &mut csv::Reader<R>, rec: &mut csv::ByteRecord, bytes: &[u8]) -> Result<Columns, InputError> {
         let file = &self.path;
         if !self.next_record(rdr, rec)? {
             return Err(InputError::File {
@@ -198,13 +256,26 @@ impl LogReader {
                 file: file.clone(),
                 line: header_line,
                 message: format!(
-                    "{what} column '{name}' not found (columns: {}). Set [channels].{what}.column or override it in this [[test]]",
-                    names.join(", ")
+                    "{what} column '{}' not found (columns: {}). Set [channels].{what}.column or override it in this [[test]]",
+                    excerpt(name, 60),
+                    shown_names(&names)
                 ),
             })
         };
         let time = find(&self.time_column, "time")?;
         let disp = find(&self.disp_column, "displacement")?;
+        if time == disp {
+            // issue 22: this used to read as "no release found" in every test.
+            return Err(InputError::Line {
+                file: file.clone(),
+                line: header_line,
+                message: format!(
+                    "the time and the displacement channels both name column '{}' (column {}): expected two different columns. Check [channels].time.column and [channels].displacement.column",
+                    excerpt(&self.time_column, 60),
+                    time + 1
+                ),
+            });
+        }
         Ok(Columns {
             n_names: names.len(),
             header_line,
@@ -215,9 +286,9 @@ impl LogReader {
 
     /// Read the numeric rows into `data`. A defective row is an error unless it is
     /// the last one: then it is returned (line, error) for the caller to judge.
-    fn rows(
+    fn rows<R: Read>(
         &self,
-        rdr: &mut csv::Reader<&[u8]>,
+        rdr: &mut csv::Reader<R>,
         rec: &mut csv::ByteRecord,
         cols: &Columns,
         decimal: Decimal,
@@ -335,6 +406,47 @@ impl LogReader {
     }
 }
 
+/// Bytes of a log read before its format is detected: the header and the first
+/// rows the detection samples are in them unless the metadata is unusually long.
+pub const PREFIX_BYTES: usize = 1 << 20;
+
+/// A reader that remembers the last byte it gave (whether the file ends with a
+/// line end, without holding the file).
+struct LastByte<R> {
+    inner: R,
+    last: Option<u8>,
+}
+
+impl<R: Read> Read for LastByte<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        if n > 0 {
+            self.last = Some(buf[n - 1]);
+        }
+        Ok(n)
+    }
+}
+
+/// Rows to reserve per kept column: the file's size over the mean length of the
+/// prefix's data lines (after the first 8 lines), +5 %; at most 10⁸ rows.
+fn approx_rows(prefix: &[u8], size: u64) -> usize {
+    let lines: Vec<usize> = prefix.split(|b| *b == b'\n').skip(8).take(200).map(|l| l.len() + 1).collect();
+    if lines.len() < 2 {
+        return 0;
+    }
+    let mean = lines.iter().sum::<usize>() as f64 / lines.len() as f64;
+    ((size as f64 / mean.max(2.0)) * 1.05).min(1e8) as usize
+}
+
+/// The header's names for a message: each at most 40 characters, at most 20 of them.
+fn shown_names(names: &[String]) -> String {
+    let mut s: Vec<String> = names.iter().take(20).map(|n| excerpt(n, 40)).collect();
+    if names.len() > 20 {
+        s.push(format!("… {} in all", names.len()));
+    }
+    s.join(", ")
+}
+
 /// 1-based line number of the header: the first line that is neither blank nor a
 /// '#' metadata line.
 fn header_line_number(bytes: &[u8]) -> u64 {
@@ -375,7 +487,7 @@ fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, S
             buf.as_slice()
         }
     };
-    let shown = || String::from_utf8_lossy(cell).into_owned();
+    let shown = || excerpt(&String::from_utf8_lossy(cell), 60);
     if text.is_empty() {
         return Err("empty cell: expected a number".into());
     }

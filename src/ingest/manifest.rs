@@ -217,12 +217,10 @@ fn bad(path: &Path, msg: impl std::fmt::Display) -> FileError {
     FileError::invalid(path, msg)
 }
 
-fn positive(path: &Path, key: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(bad(path, format!("{key} = {v}: expected a positive number")))
-    }
+/// A length within [`crate::limits::LENGTH_M`] (1 mm to 1 km), the refusal naming
+/// the key and the range (issue 22).
+fn length(path: &Path, key: &str, v: f64) -> Result<f64> {
+    crate::limits::LENGTH_M.check(key, v).map_err(|m| bad(path, m))
 }
 
 fn sign(path: &Path, where_: &str, v: i64) -> Result<f64> {
@@ -267,8 +265,8 @@ struct WallValues {
 }
 
 fn validate_wall(w: &RawWall, path: &Path) -> Result<WallValues> {
-    let height_m = positive(path, "[wall].height_m", w.height_m)?;
-    let thickness_m = positive(path, "[wall].thickness_m", w.thickness_m)?;
+    let height_m = length(path, "[wall].height_m", w.height_m)?;
+    let thickness_m = length(path, "[wall].thickness_m", w.thickness_m)?;
     if !(w.hinge_height_m.is_finite() && w.hinge_height_m >= 0.0 && w.hinge_height_m < height_m) {
         return Err(bad(
             path,
@@ -347,13 +345,23 @@ fn test_channels(t: &RawTest, d: &Defaults, path: &Path, where_: &str) -> Result
 fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
     let where_ = format!("[[test]] id = {:?}: ", t.id);
     let (time, displacement, outward_sign) = test_channels(t, d, path, &where_)?;
+    if time.column == displacement.column {
+        // issue 22: this used to read as "no release found" in every test.
+        return Err(bad(
+            path,
+            format!(
+                "{where_}the time and the displacement channels both name column {:?}: expected two columns (check [channels].time.column and [channels].displacement.column)",
+                crate::error::excerpt(&time.column, 60)
+            ),
+        ));
+    }
     let sensor_h = displacement.height_m.ok_or_else(|| {
         bad(
             path,
             format!("{where_}displacement.height_m is missing: the sensor height above the base is needed to turn displacement into rotation"),
         )
     })?;
-    let sensor_h = positive(path, "displacement.height_m", sensor_h)?;
+    let sensor_h = length(path, &format!("{where_}displacement.height_m"), sensor_h)?;
     let lever_arm_m = sensor_h - d.hinge_height_m;
     if lever_arm_m <= 0.0 {
         return Err(bad(
@@ -361,12 +369,23 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
             format!("{where_}sensor height {sensor_h} m is not above the hinge ({} m)", d.hinge_height_m),
         ));
     }
+    if t.file.len() > 4096 || Path::new(&t.file).components().any(|c| c.as_os_str().len() > 255) {
+        return Err(bad(
+            path,
+            format!(
+                "{where_}file = \"{}\": expected a path of at most 4096 bytes, 255 per name",
+                crate::error::excerpt(&t.file, 60)
+            ),
+        ));
+    }
     let format = match &t.format {
         Some(f) => parse_format(path, &format!("{where_}format."), f)?,
         None => d.format,
     };
     if let Some(x) = t.imposed_displacement_mm {
-        positive(path, "imposed_displacement_mm", x)?;
+        crate::limits::Range::new(1e-3, 1e4, "mm")
+            .check(&format!("{where_}imposed_displacement_mm"), x)
+            .map_err(|m| bad(path, m))?;
     }
     Ok(TestSpec {
         id: t.id.clone(),

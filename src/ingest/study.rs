@@ -12,6 +12,7 @@ use crate::error::{FileError, FileKind};
 use crate::facade::{calibration_set, normal_or_fixed, CoefficientSet, Im, Study, StudyRecord};
 use crate::ground_motion::{Format, ReadOptions, Units};
 use crate::ingest::text::{parse_toml, read_text};
+use crate::limits;
 use crate::solver::BlockSpec;
 use crate::wall::housner_e;
 
@@ -134,12 +135,43 @@ fn parse_dist(path: &Path, key: &str, v: &toml::Value) -> Result<Dist> {
     }
 }
 
+/// The physical range of an `[uncertainty]` input, when it has one.
+fn uncertainty_range(key: &str) -> Option<limits::Range> {
+    Some(match key {
+        "magnification" => limits::MAGNIFICATION,
+        "r_m" | "contact_height_m" => limits::LENGTH_M,
+        "alpha_rad" => limits::Range::new(1e-4, 1.5, "rad"),
+        "i0_kg_m2" => limits::Range::new(1e-3, 1e13, "kg m²"),
+        "unit_stiffness_mn_m2" => limits::STIFFNESS,
+        _ => return None,
+    })
+}
+
+/// A distribution whose support (uniform) or mean (normal) lies in `range`.
+fn dist_in_range(path: &Path, key: &str, d: Dist, range: limits::Range) -> Result<()> {
+    let ends = match d {
+        Dist::Uniform { lo, hi } => vec![lo, hi],
+        Dist::Normal { mean, .. } => vec![mean],
+        Dist::Fixed { value } => vec![value],
+    };
+    match ends.iter().find(|v| !range.contains(**v)) {
+        Some(v) => Err(bad(
+            path,
+            format!("[uncertainty].{key}: {}: expected a value {}", limits::show(*v), range.describe()),
+        )),
+        None => Ok(()),
+    }
+}
+
 /// `[uncertainty]`: magnification, r_m, alpha_rad, i0_kg_m2, unit_stiffness_mn_m2,
 /// contact_height_m; unknown keys are rejected by name.
 fn parse_uncertainty(path: &Path, t: &toml::Table, block: &BlockSpec) -> Result<Uncertainty> {
     let mut u = Uncertainty::default();
     for (k, v) in t {
         let d = Some(parse_dist(path, k, v)?);
+        if let (Some(dist), Some(range)) = (d, uncertainty_range(k)) {
+            dist_in_range(path, k, dist, range)?;
+        }
         match k.as_str() {
             "magnification" => u.magnification = d,
             "r_m" => u.r_m = d,
@@ -315,6 +347,23 @@ fn choices(path: &Path, h: &RawHead) -> Result<(Vec<f64>, PolarityMode, Im)> {
     Ok((polarities, polarity_mode, im))
 }
 
+/// The `[study]` numbers within their physical ranges ([`crate::limits`]; issue 22:
+/// `rtol = 1e-308` ran without end, `rtol = 1e308` failed naming neither file nor key).
+fn head_ranges(path: &Path, h: &RawHead) -> Result<()> {
+    let check = |key: &str, v: f64, r: limits::Range| r.check(&format!("[study].{key}"), v).map(|_| ()).map_err(|m| bad(path, m));
+    check("magnification", h.magnification, limits::MAGNIFICATION)?;
+    check("t_extra_s", h.t_extra_s, limits::T_EXTRA_S)?;
+    if let Some(r) = h.rtol {
+        check("rtol", r, limits::RTOL)?;
+    }
+    for (key, n) in [("samples", h.samples), ("ida_samples", h.ida_samples)] {
+        if let Some(n) = n.filter(|n| *n > limits::MAX_SAMPLES) {
+            return Err(bad(path, format!("[study].{key} = {n}: expected at most {}", limits::MAX_SAMPLES)));
+        }
+    }
+    Ok(())
+}
+
 /// The reader of a study file (the type is the façade study's).
 impl Study {
     /// Read and validate a study file and everything it names.
@@ -327,12 +376,7 @@ impl Study {
         let base = path.parent().unwrap_or_else(|| Path::new("."));
         let block = BlockSpec::load(&base.join(&raw.study.block))?;
         let h = &raw.study;
-        if !(h.magnification.is_finite() && h.magnification > 0.0) {
-            return Err(bad(
-                path,
-                format!("[study].magnification = {}: expected a positive number", h.magnification),
-            ));
-        }
+        head_ranges(path, h)?;
         let (polarities, polarity_mode, im) = choices(path, h)?;
         if raw.record.is_empty() {
             return Err(bad(path, "no [[record]]: expected at least one record"));
@@ -340,12 +384,9 @@ impl Study {
         let sets = coefficient_sets(path, base, &raw.coefficients, block.block.alpha)?;
         let records = records(path, base, &raw.record)?;
         let overturn_limit = h.overturn_limit_rad.unwrap_or(block.block.alpha);
-        if overturn_limit.is_nan() || overturn_limit <= 0.0 {
-            return Err(bad(
-                path,
-                format!("[study].overturn_limit_rad = {overturn_limit}: expected a positive angle"),
-            ));
-        }
+        limits::ANGLE_RAD
+            .check("[study].overturn_limit_rad", overturn_limit)
+            .map_err(|m| bad(path, m))?;
         let uncertainty = match &raw.uncertainty {
             Some(t) => parse_uncertainty(path, t, &block)?,
             None => Uncertainty::default(),

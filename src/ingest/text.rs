@@ -45,7 +45,13 @@ pub fn parse_toml<T: serde::de::DeserializeOwned>(text: &str, path: &Path) -> Re
             file: path.to_path_buf(),
             line,
             column,
-            message: e.to_string().trim_end().to_string(),
+            message: e
+                .to_string()
+                .trim_end()
+                .lines()
+                .map(|l| crate::error::excerpt(l, 120))
+                .collect::<Vec<_>>()
+                .join("\n"),
         }
     })
 }

@@ -155,7 +155,7 @@ fn figures(res: &CampaignResult, cal: &Calibration, n_impacts: usize) -> Result<
         // The late half-cycles: every arc after the first two impacts.
         let late_from = r.analysis.impacts.get(1).map(|i| i.time_s);
         figs.push(Captioned {
-            stem: format!("{}_replay", f.id),
+            stem: format!("{}_replay", super::file_stem(&f.id)),
             caption: format!(
                 "Test {}: measured displacement and the solver's replay with the fitted coefficients, the residual, and the late half-cycles enlarged.",
                 f.id

@@ -54,8 +54,9 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
         Vec::new()
     };
     for (id, motion, ratios) in &figs {
-        motion.add_to(&mut files, &format!("plots/{id}_motion"));
-        ratios.add_to(&mut files, &format!("plots/{id}_ratios"));
+        let stem = super::file_stem(id);
+        motion.add_to(&mut files, &format!("plots/{stem}_motion"));
+        ratios.add_to(&mut files, &format!("plots/{stem}_ratios"));
     }
     let page = reduce_page(res, &tabs, &figs, &extra.html_sections, sources);
     files.add("report.html", page);

@@ -50,7 +50,7 @@ pub fn simulate_summary(
     sim: &Simulation,
 ) -> Result<Value, ReportError> {
     let b = &block.block;
-    let mut doc = serde_json::to_value(SimulateDoc {
+    let mut doc = super::json_value(&SimulateDoc {
         block: &block.name,
         record: record_name,
         record_notes: &record.notes,
@@ -104,7 +104,7 @@ struct CalibrationDoc<'a> {
 /// The `"calibration"` entry that `rocklab calibrate` adds to `summary.json`;
 /// `wall_s` is how long the calibration took. Each test is its [`TestFit`].
 pub fn calibration_summary(cal: &Calibration, wall_s: f64) -> Result<Value, ReportError> {
-    Ok(serde_json::to_value(CalibrationDoc {
+    super::json_value(&CalibrationDoc {
         e_in: cal.e_in,
         e_out: cal.e_out,
         r_in: cal.r_in,
@@ -116,7 +116,7 @@ pub fn calibration_summary(cal: &Calibration, wall_s: f64) -> Result<Value, Repo
         per_impact: cal.per_impact.iter().map(|(id, i, o)| PerImpact { id, inward: i, outward: o }).collect(),
         failed: cal.failed.iter().map(|(id, e)| Failure { id, error: e }).collect(),
         wall_s,
-    })?)
+    })
 }
 
 /// The ensemble section of the façade summary.
@@ -168,7 +168,7 @@ pub fn facade_summary(
     ensemble: Option<EnsembleDoc>,
     fragility: Option<FragilityDoc>,
 ) -> Result<Value, ReportError> {
-    let mut doc = serde_json::to_value(FacadeDoc {
+    let mut doc = super::json_value(&FacadeDoc {
         study: &study.name,
         block: &study.block.name,
         alpha_rad: study.block.block.alpha,

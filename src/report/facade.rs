@@ -305,7 +305,7 @@ fn response_figures(study: &Study, runs: &[StudyRun]) -> Result<Vec<Captioned>> 
             }
         }
         figs.push(Captioned {
-            stem: format!("response_{}", rec.name),
+            stem: format!("response_{}", super::file_stem(&rec.name)),
             caption: format!(
                 "{}: θ/α under each coefficient set, per polarity, and the scaled ground acceleration (paper Fig. 8/9).",
                 rec.name
@@ -388,7 +388,7 @@ fn ida_set_figure(study: &Study, set: &CoefficientSet, pts: &[IdaPoint]) -> Resu
         series,
     );
     Ok(Captioned {
-        stem: format!("ida_{}", set.name),
+        stem: format!("ida_{}", super::file_stem(&set.name)),
         caption: format!(
             "IDA with the {} coefficients: max θ/α against the scale factor per record and polarity.",
             set.name

@@ -8,6 +8,7 @@ pub mod calibration;
 pub mod campaign;
 pub mod docs;
 pub mod facade;
+pub mod finite;
 pub mod html;
 pub mod parquet;
 pub mod plots;
@@ -35,6 +36,38 @@ pub enum ReportError {
     Toml(#[from] toml::ser::Error),
     #[error("writing {path}: {source}")]
     Write { path: PathBuf, source: std::io::Error },
+    /// An output path that would leave the output folder, or two outputs under one name.
+    #[error("output {path}: {why}; nothing was written")]
+    Path { path: String, why: String },
+    /// NaN or an infinity in an output (issue 22).
+    #[error("{0}; nothing was written")]
+    NonFinite(#[from] finite::NonFinite),
+}
+
+/// A name from an input (a test id, a record or a coefficient-set name) as one
+/// file-name component, so that every output stays under `--out` (issue 22):
+/// letters, digits, `-`, `_` and `.` are kept, anything else (separators, `..`
+/// as a leading dot, NUL, spaces) becomes `_`, and the result is at most 100
+/// characters and never empty.
+pub fn file_stem(name: &str) -> String {
+    let mut s: String = name
+        .chars()
+        .map(|c| if c.is_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' })
+        .take(100)
+        .collect();
+    let dots = s.len() - s.trim_start_matches('.').len();
+    s.replace_range(..dots, &"_".repeat(dots));
+    if s.is_empty() {
+        s.push('_');
+    }
+    s
+}
+
+/// A `Serialize` document as a JSON value, refused when it holds a NaN or an
+/// infinity (serde_json would write `null`: [`finite::check_serialize`]).
+pub(crate) fn json_value<T: serde::Serialize>(doc: &T) -> Result<serde_json::Value, ReportError> {
+    finite::check_serialize(doc)?;
+    Ok(serde_json::to_value(doc)?)
 }
 
 /// Files to write, by path relative to the output folder, in order.
@@ -58,11 +91,32 @@ impl Files {
 }
 
 /// The one writer: every file under `dir` (folders created), each atomically
-/// ([`crate::atomic::write_atomic`]: a temporary sibling, then a rename).
+/// ([`crate::atomic::write_under`]: a temporary sibling, then a rename).
+/// Before the first byte is written, every file is checked ([`check_files`]): a
+/// path that would leave `dir`, two files under one path, or a non-finite number
+/// in a text output refuses the whole set, so a failed run writes nothing.
 pub fn write_files(dir: &Path, files: &Files) -> Result<(), ReportError> {
+    check_files(files)?;
     for (rel, bytes) in &files.0 {
-        let path = dir.join(rel);
-        crate::atomic::write_atomic(&path, bytes).map_err(|source| ReportError::Write { path, source })?;
+        crate::atomic::write_under(dir, rel, bytes).map_err(|source| ReportError::Write { path: dir.join(rel), source })?;
+    }
+    Ok(())
+}
+
+/// Every path relative, made of plain components (no `..`, root, prefix, NUL,
+/// component over 255 bytes), each path once; every text output finite.
+pub fn check_files(files: &Files) -> Result<(), ReportError> {
+    let mut seen = std::collections::HashSet::new();
+    for (rel, bytes) in &files.0 {
+        let shown = || crate::error::excerpt(&rel.to_string_lossy(), 60);
+        crate::atomic::check_relative(rel).map_err(|why| ReportError::Path { path: shown(), why })?;
+        if !seen.insert(rel.as_path()) {
+            return Err(ReportError::Path {
+                path: shown(),
+                why: "two outputs under one name (two inputs whose names differ only in characters a file name cannot hold?)".into(),
+            });
+        }
+        finite::check_bytes(&rel.to_string_lossy(), bytes)?;
     }
     Ok(())
 }
@@ -93,6 +147,31 @@ impl InputFile {
             role: role.into(),
             path: path.to_path_buf(),
             facts,
+        }
+    }
+    /// Describe a file from a reader of its bytes, hashed as they stream (issue
+    /// 22: a 242 MB log is not held whole to be hashed).
+    pub fn from_reader(role: &str, path: &Path, read: std::io::Result<impl std::io::Read>) -> InputFile {
+        use sha2::{Digest, Sha256};
+        let facts = read.and_then(|mut r| {
+            let (mut h, mut n, mut buf) = (Sha256::new(), 0usize, vec![0u8; 1 << 16]);
+            loop {
+                match r.read(&mut buf) {
+                    Ok(0) => break,
+                    Ok(k) => {
+                        h.update(&buf[..k]);
+                        n += k;
+                    }
+                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                    Err(e) => return Err(e),
+                }
+            }
+            Ok((n, h.finalize().iter().map(|x| format!("{x:02x}")).collect()))
+        });
+        InputFile {
+            role: role.into(),
+            path: path.to_path_buf(),
+            facts: facts.map_err(|e| format!("unreadable: {e}")),
         }
     }
     /// The provenance row: role, path, size, SHA-256.

@@ -123,7 +123,7 @@ pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
         mean_included: &res.means.included,
         mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
     };
-    let mut v = serde_json::to_value(doc)?;
+    let mut v = super::json_value(&doc)?;
     if let Value::Object(m) = &mut v {
         m.extend(identity(c));
     }

@@ -15,9 +15,9 @@ use nalgebra::DMatrix;
 /// A window or an order that no Savitzky–Golay filter has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum SavGolError {
-    #[error("Savitzky–Golay window {window}: expected an odd number ≥ 3")]
+    #[error("Savitzky–Golay window {window}: expected an odd number from 3 to 1001")]
     Window { window: usize },
-    #[error("Savitzky–Golay order {order}: expected an order below the window ({window})")]
+    #[error("Savitzky–Golay order {order}: expected an order below the window ({window}) and at most 10")]
     Order { order: usize, window: usize },
 }
 
@@ -28,12 +28,13 @@ pub struct SavGol {
 }
 
 impl SavGol {
-    /// `window` odd and ≥ 3, `order` < `window`.
+    /// `window` odd, 3 ≤ window ≤ 1001, `order` < `window` and ≤ 10 (issue 22:
+    /// bounds under which the Vandermonde matrix stays finite and well scaled).
     pub fn new(window: usize, order: usize) -> Result<SavGol, SavGolError> {
-        if window < 3 || window.is_multiple_of(2) {
+        if !(3..=1001).contains(&window) || window.is_multiple_of(2) {
             return Err(SavGolError::Window { window });
         }
-        if order >= window {
+        if order >= window || order > 10 {
             return Err(SavGolError::Order { order, window });
         }
         Ok(SavGol {

@@ -10,7 +10,7 @@ use crate::wall::Side;
 /// Settings, an initial state or a record the solver cannot run with.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolverError {
-    #[error("tolerances rtol = {rtol}, atol = {atol}: expected positive numbers")]
+    #[error("tolerances rtol = {rtol}, atol = {atol}: expected values from 1e-15 to 0.1")]
     Tolerances { rtol: f64, atol: f64 },
     #[error("{what} = {value}: expected a positive number")]
     NotPositive { what: &'static str, value: f64 },
@@ -20,7 +20,23 @@ pub enum SolverError {
     Initial { theta: f64, omega: f64 },
     #[error("ground motion: time step dt = {dt} and start t0 = {t0}: expected dt > 0 and finite t0")]
     Ground { dt: f64, t0: f64 },
+    /// The integrator rejected [`MAX_REJECTIONS`] steps in a row (issue 22: a
+    /// record scaled by 10³⁰⁰ or a tolerance of 10⁻³⁰⁸ used to retry for ever).
+    #[error("the integrator did not converge at t = {t} s: {rejections} steps rejected in a row, the last of {h:e} s (a ground motion or a tolerance out of the physical range?)")]
+    Rejections { t: f64, h: f64, rejections: usize },
+    /// The run took more than [`MAX_STEPS`] integration steps.
+    #[error("the integrator did not finish: {steps} steps reached at t = {t} s of {t_end} s (a ground motion out of the physical range?)")]
+    Steps { t: f64, t_end: f64, steps: usize },
 }
+
+/// Steps rejected in a row after which a run fails ([`SolverError::Rejections`]):
+/// a rejection at least halves the step (Dormand–Prince's factor ≤ 0.2 or the
+/// hop retry's 0.25), so 200 take any step to the 10⁻¹² s floor and well past it.
+pub const MAX_REJECTIONS: usize = 200;
+
+/// Integration steps (accepted or not) after which a run fails
+/// ([`SolverError::Steps`]): the façade records (≤ 60 s) take ~10⁴–10⁵.
+pub const MAX_STEPS: usize = 20_000_000;
 
 /// Settings of a run; defaults: rtol 1e-9, atol 1e-12, rest below 1e-7 rad/s,
 /// history kept, steps at most 10 ms.
@@ -60,7 +76,7 @@ impl Settings {
     /// finite end. [`simulate`] checks it before it runs.
     pub fn validate(&self) -> Result<(), SolverError> {
         let Tolerances { rtol, atol } = self.tol;
-        if !(rtol > 0.0 && atol > 0.0 && rtol.is_finite() && atol.is_finite()) {
+        if !(crate::limits::SOLVER_TOL.contains(rtol) && crate::limits::SOLVER_TOL.contains(atol)) {
             return Err(SolverError::Tolerances { rtol, atol });
         }
         if self.max_step.is_nan() || self.max_step <= 0.0 {
@@ -202,7 +218,7 @@ pub fn simulate_at(
     };
     let th0 = initial.map_or(0.0, |s| s[0]);
     out.fill(t0, |_| th0);
-    let sim = simulate_inner(model, ground, t0, initial, settings, &mut out);
+    let sim = simulate_inner(model, ground, t0, initial, settings, &mut out)?;
     // After the run: its final θ (known from the history when kept), else the last
     // value output.
     let fill_value = match sim.history.last() {
@@ -214,12 +230,40 @@ pub fn simulate_at(
 }
 
 /// The event loop: [`Loop::step`] until it says the run stopped.
-fn simulate_inner(model: &RockingModel, ground: &Ground, t0: f64, initial: Option<State>, settings: &Settings, out: &mut Outputs) -> Simulation {
+/// Bounded: [`MAX_REJECTIONS`] rejections in a row or [`MAX_STEPS`] steps end it
+/// with an error.
+fn simulate_inner(
+    model: &RockingModel,
+    ground: &Ground,
+    t0: f64,
+    initial: Option<State>,
+    settings: &Settings,
+    out: &mut Outputs,
+) -> Result<Simulation, SolverError> {
     let mut run = Loop::new(model, ground, t0, initial, settings, out);
+    let mut rejections = 0;
     loop {
-        if let StepOutcome::Stopped(stop) = run.step() {
-            run.sim.stop = stop;
-            return run.sim;
+        match run.step() {
+            StepOutcome::Stopped(stop) => {
+                run.sim.stop = stop;
+                return Ok(run.sim);
+            }
+            StepOutcome::Rejected => rejections += 1,
+            _ => rejections = 0,
+        }
+        if rejections >= MAX_REJECTIONS {
+            return Err(SolverError::Rejections {
+                t: run.t,
+                h: run.h,
+                rejections,
+            });
+        }
+        if run.sim.steps >= MAX_STEPS {
+            return Err(SolverError::Steps {
+                t: run.t,
+                t_end: settings.t_end,
+                steps: run.sim.steps,
+            });
         }
     }
 }

@@ -1,0 +1,210 @@
+//! Issue 22, end to end on the built binary: names from the inputs that become
+//! file names (test ids in `reduce` with plots, record names in `facade`,
+//! coefficient-set names in `facade --scales`) never write outside `--out`,
+//! whatever they hold (`..`, absolute paths, separators, NUL); the one writer
+//! refuses a path that leaves `--out` and any non-finite number, writing nothing.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rocklab::report::{write_files, Files};
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures")
+}
+
+/// Every file below `dir`, relative to it.
+fn tree(dir: &Path) -> BTreeSet<PathBuf> {
+    let mut out = BTreeSet::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(p.strip_prefix(dir).unwrap().to_path_buf());
+            }
+        }
+    }
+    out
+}
+
+fn run(args: &[&std::ffi::OsStr]) -> (i32, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab")).args(args).output().unwrap();
+    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// The hostile names: parent folders, an absolute path, separators, NUL (as TOML
+/// escapes), a leading dot.
+const NAMES: &[&str] = &[
+    "../../escaped",
+    "/../../escaped",
+    "/tmp/escaped",
+    "a/b\\\\c",
+    "a\\u0000b",
+    ".hidden",
+    "..",
+];
+
+/// Runs `args` (with OUT for the output folder) in a fresh folder holding
+/// `files`, and checks that every file written is under OUT (`root/a/b/out`).
+fn stays_inside(files: &[(&str, Vec<u8>)], args: &[&str]) -> BTreeSet<PathBuf> {
+    let root = tempfile::tempdir().unwrap();
+    let work = root.path().join("a/b");
+    std::fs::create_dir_all(&work).unwrap();
+    for (name, bytes) in files {
+        std::fs::write(work.join(name), bytes).unwrap();
+    }
+    let before = tree(root.path());
+    let out = work.join("out");
+    let args: Vec<std::ffi::OsString> = args
+        .iter()
+        .map(|a| match *a {
+            "OUT" => out.clone().into_os_string(),
+            f if f.ends_with(".toml") => work.join(f).into_os_string(),
+            other => other.into(),
+        })
+        .collect();
+    let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let (code, stderr) = run(&refs);
+    assert_eq!(code, 0, "{stderr}");
+    let after = tree(root.path());
+    let new: Vec<_> = after.difference(&before).collect();
+    assert!(!new.is_empty());
+    for p in &new {
+        assert!(p.starts_with("a/b/out"), "{} written outside --out", p.display());
+    }
+    for (name, bytes) in files {
+        assert_eq!(&std::fs::read(work.join(name)).unwrap(), bytes, "{name} modified");
+    }
+    tree(&out)
+}
+
+// issue 22: a test id "../../x" made `reduce` (with plots) write PNG/SVG files in
+// the parents of --out.
+#[test]
+fn reduce_test_ids_stay_inside_out() {
+    let log = std::fs::read(fixtures().join("campaigns/one-sided-demo/150_1.csv")).unwrap();
+    let mut manifest = String::from_utf8(std::fs::read(fixtures().join("campaigns/one-sided-demo/campaign.toml")).unwrap()).unwrap();
+    manifest.truncate(manifest.find("[[test]]").unwrap());
+    for (i, name) in NAMES.iter().enumerate() {
+        manifest.push_str(&format!("[[test]]\nid = \"{name}\"\nfile = \"log{i}.csv\"\n"));
+    }
+    let mut files = vec![("campaign.toml", manifest.into_bytes())];
+    let logs: Vec<String> = (0..NAMES.len()).map(|i| format!("log{i}.csv")).collect();
+    files.extend(logs.iter().map(|l| (l.as_str(), log.clone())));
+    let out = stays_inside(&files, &["reduce", "campaign.toml", "--out", "OUT"]);
+    let plots = out.iter().filter(|p| p.starts_with("plots")).count();
+    assert_eq!(plots, 4 * NAMES.len(), "{out:?}");
+}
+
+fn study(record_names: &[&str], set_names: &[&str]) -> String {
+    let mut s = String::from("[study]\nname = \"s\"\nblock = \"block.toml\"\nmagnification = 1.27\nsamples = 0\n");
+    for r in record_names {
+        s.push_str(&format!("[[record]]\nname = \"{r}\"\nfile = \"pulse.AT2\"\n"));
+    }
+    for (i, c) in set_names.iter().enumerate() {
+        s.push_str(&format!("[[coefficients]]\nname = \"{c}\"\ne = {}\n", 0.9 - 0.01 * i as f64));
+    }
+    s
+}
+
+fn study_files(text: String) -> Vec<(&'static str, Vec<u8>)> {
+    vec![
+        ("study.toml", text.into_bytes()),
+        ("block.toml", std::fs::read(fixtures().join("facade/block.toml")).unwrap()),
+        (
+            "pulse.AT2",
+            std::fs::read(fixtures().join("ground-motions/synthetic/one_sine_pulse_nga.AT2")).unwrap(),
+        ),
+    ]
+}
+
+// issue 22: a record named "/../../escaped" (facade) and a coefficient set named
+// the same way (facade --scales) wrote files in the parents of --out; a record
+// name with NUL made facade stop after 11 of its files.
+#[test]
+fn facade_record_and_set_names_stay_inside_out() {
+    let out = stays_inside(&study_files(study(NAMES, &["housner"])), &["facade", "study.toml", "--out", "OUT"]);
+    let responses = out.iter().filter(|p| p.to_string_lossy().starts_with("response_")).count();
+    assert_eq!(responses, 2 * NAMES.len(), "{out:?}");
+    assert!(out.contains(Path::new("summary.json")) && out.contains(Path::new("report.html")));
+    let out = stays_inside(
+        &study_files(study(&["r"], NAMES)),
+        &["facade", "study.toml", "--out", "OUT", "--scales", "0.5:1.0:2"],
+    );
+    let ida = out
+        .iter()
+        .filter(|p| p.to_string_lossy().starts_with("ida_") && p.extension().is_some_and(|x| x == "svg"))
+        .count();
+    assert_eq!(ida, NAMES.len() + 1, "one figure per set and the fraction: {out:?}");
+}
+
+// issue 22: two names that make one file name are refused before anything is
+// written, not written over each other.
+#[test]
+fn two_names_making_one_file_are_refused_and_nothing_written() {
+    let root = tempfile::tempdir().unwrap();
+    for (name, bytes) in study_files(study(&["a/b", "a_b"], &["housner"])) {
+        std::fs::write(root.path().join(name), bytes).unwrap();
+    }
+    let out = root.path().join("out");
+    let (code, stderr) = run(&[
+        "facade".as_ref(),
+        root.path().join("study.toml").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("two outputs under one name"), "{stderr}");
+    assert!(!out.exists());
+}
+
+// issue 22: the writer refuses paths that leave --out and non-finite numbers,
+// writing none of the files.
+#[test]
+fn the_writer_refuses_escapes_and_non_finite_numbers_writing_nothing() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("out");
+    for bad in ["../x.csv", "/tmp/x.csv", "plots/../../x.svg", "a\0b.csv"] {
+        let mut files = Files::default();
+        files.add("ok.csv", "a\n1\n");
+        files.add(bad, "a\n1\n");
+        let e = write_files(&out, &files).unwrap_err().to_string();
+        assert!(e.contains("nothing was written"), "{e}");
+    }
+    for (name, bytes) in [
+        ("h.csv", "t,theta\n0,NaN\n"),
+        ("h.csv", "t,theta\n0,-inf\n"),
+        ("p.svg", "<path d=\"M0 NaN\"/>"),
+        ("r.md", "| inf |"),
+    ] {
+        let mut files = Files::default();
+        files.add("ok.csv", "a\n1\n");
+        files.add(name, bytes);
+        let e = write_files(&out, &files).unwrap_err().to_string();
+        assert!(e.contains("non-finite"), "{e}");
+    }
+    assert_eq!(tree(root.path()).len(), 0);
+}
+
+// issue 22: "Is a directory (os error 21): Is a directory (os error 21)".
+#[test]
+fn an_io_error_is_said_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stderr) = run(&[
+        "simulate".as_ref(),
+        "--block".as_ref(),
+        fixtures().join("facade/block.toml").as_os_str(),
+        "--record".as_ref(),
+        dir.path().as_os_str(),
+        "--e".as_ref(),
+        "0.9".as_ref(),
+        "--out".as_ref(),
+        dir.path().join("o").as_os_str(),
+    ]);
+    assert_eq!(code, 2);
+    assert_eq!(stderr.matches("os error 21").count(), 1, "{stderr}");
+}

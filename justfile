@@ -2,6 +2,9 @@
 
 default: check
 
+# rustc overflows its default stack compiling polars in the bench (optimised) profile.
+export RUST_MIN_STACK := "16777216"
+
 # Format check, lints and the tests: what CI runs.
 check: fmt-check lint test
 

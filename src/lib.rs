@@ -21,13 +21,15 @@
 //!   on [`fit`] (Levenberg–Marquardt); the façade study: [`facade`], one run in
 //!   [`study`], ensembles in [`ensemble`], fragility curves in [`fragility`].
 //!
-//! Layout: the numeric core (every module but [`ingest`], [`report`], `cli` and
-//! [`atomic`]) touches no files and names no clap, plotters or anyhow type;
+//! Layout: the numeric core (every module but [`ingest`], [`report`], [`archive`],
+//! `cli` and [`atomic`]) touches no files and names no clap, plotters or anyhow type;
 //! the domain types ([`wall::Rocking`], [`wall::Side`], [`wall::Rectangle`],
 //! [`wall::Wall`]) live there. The edges depend on it, never the reverse
-//! (`tests/architecture.rs` checks it): [`ingest`] is the only reader of files,
-//! [`report`] renders and writes, `cli` is the binary.
+//! (`tests/architecture.rs` checks it): [`ingest`] is the only reader of inputs,
+//! [`report`] renders and writes, [`archive`] keeps a lab's archive of reductions
+//! (Parquet tables queried with SQL, on polars), `cli` is the binary.
 
+pub mod archive;
 pub mod atomic;
 pub mod calibrate;
 pub mod campaign_means;

@@ -328,7 +328,7 @@ fn compliant_motion(spec: &TestSpec, theta_c: f64, c_floor: f64, c_wall: f64) ->
     while t < 30.0 {
         let k1 = f(t, &y);
         let st = step(&mut f, t, &y, &k1, hh, tol);
-        let sign = if cycles.crossings.len() % 2 == 0 { -1.0 } else { 1.0 };
+        let sign = if cycles.crossings.len().is_multiple_of(2) { -1.0 } else { 1.0 };
         let v = l * st.y1[0].cos() * st.y1[1];
         if sign * v > sign * best.1 {
             best = (t + hh, v);

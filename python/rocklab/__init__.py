@@ -6,6 +6,7 @@ Rust library code as the ``rocklab`` command line:
 
 - :func:`reduce` (``rocklab reduce``), :func:`reduce_log` (one test given as arrays),
 - :func:`simulate` (``rocklab simulate``), :func:`calibrate` (``rocklab calibrate``),
+- :func:`archive` (the tables of ``rocklab archive``),
 - :func:`facade` (``rocklab facade``), :func:`facade_ensembles` (its uncertainty
   ensembles and fragility curves) and :func:`facade_runs` (any selection of a
   study's runs; :mod:`rocklab.dask` spreads them over a Dask cluster).
@@ -62,6 +63,7 @@ __all__ = [
     "study_info",
     "parse_scales",
     "read_csv",
+    "archive",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -639,3 +641,20 @@ def facade_runs(
     payload = json.dumps([[str(r), str(s), int(p), float(sc)] for r, s, p, sc in runs])
     out = json.loads(_rocklab.facade_runs(os.fspath(study), payload, sensitivity, parallel))
     return _frame(_run_rows(out))
+
+
+def archive(path: PathLike):
+    """The tables of a lab archive (``rocklab archive add … --to PATH``) as
+    ``(tests, impacts)`` DataFrames: polars when it is installed, else pandas (which
+    reads Parquet through pyarrow). An interrupted ``archive add`` is finished or
+    discarded first, as the CLI does. Columns: ``docs/archive.md``."""
+    tests_path, impacts_path = _rocklab.archive_tables(os.fspath(path))
+    try:
+        import polars as pl
+    except ImportError:
+        pl = None
+    if pl is not None:
+        return pl.read_parquet(tests_path), pl.read_parquet(impacts_path)
+    if _pd is None:
+        raise RocklabError("rocklab.archive needs polars, or pandas with pyarrow: pip install polars")
+    return _pd.read_parquet(tests_path), _pd.read_parquet(impacts_path)

@@ -70,7 +70,7 @@ fn to_python<'py>(py: Python<'py>, doc: Value, series: Series) -> PyResult<(Stri
 
 /// f64 values from little-endian bytes (the package sends `ndarray.tobytes()`).
 fn f64s(name: &str, b: &[u8]) -> anyhow::Result<Vec<f64>> {
-    if b.len() % 8 != 0 {
+    if !b.len().is_multiple_of(8) {
         bail!("{name}: {} bytes is not a whole number of float64 values", b.len());
     }
     Ok(b.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
@@ -465,6 +465,16 @@ fn facade_ensembles(
     Ok(doc.to_string())
 }
 
+/// The two table files of an archive (`rocklab archive`), an interrupted change
+/// finished or discarded first.
+#[pyfunction]
+fn archive_tables(py: Python<'_>, archive: PathBuf) -> PyResult<Vec<String>> {
+    guarded(py, move || {
+        let paths = rocklab::archive::open(&archive)?;
+        Ok(paths.iter().map(|p| p.display().to_string()).collect())
+    })
+}
+
 /// Scale factors of `--scales FROM:TO:N`.
 #[pyfunction]
 fn parse_scales(py: Python<'_>, text: &str) -> PyResult<Vec<f64>> {
@@ -567,6 +577,7 @@ fn _rocklab(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(facade, m)?)?;
     m.add_function(wrap_pyfunction!(parse_scales, m)?)?;
+    m.add_function(wrap_pyfunction!(archive_tables, m)?)?;
     m.add_function(wrap_pyfunction!(study_info, m)?)?;
     m.add_function(wrap_pyfunction!(facade_runs, m)?)?;
     m.add_function(wrap_pyfunction!(facade_ensembles, m)?)?;

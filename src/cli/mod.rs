@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod archive;
 mod calibrate;
 mod demo;
 mod facade;
@@ -38,6 +39,8 @@ enum Command {
     Simulate(simulate::SimulateArgs),
     /// Façade study: coefficient sets × records × polarities (and scales).
     Facade(facade::FacadeArgs),
+    /// A lab's archive of reduced campaigns: add reductions, query them with SQL.
+    Archive(archive::ArchiveArgs),
     /// Reduce the fixture campaigns shipped in `fixtures/` into `reports/demo/`.
     Demo(DemoArgs),
 }
@@ -107,6 +110,7 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Facade(a) => facade::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Archive(a) => archive::run(a),
     }
 }
 

@@ -5,6 +5,8 @@
 //! The csv crate splits the records (it handles quoting and CRLF and reports line
 //! numbers); numbers are parsed here so that a decimal comma costs no copy of the
 //! file. Every defect is an [`InputError`] naming the file, line and column.
+//! Logs in the loggers' own formats (.xlsx, .tdms, .mat, .parquet, by extension)
+//! are handed to `ingest::formats` by [`LogReader::read`].
 //!
 //! Memory (issue 22): the file is streamed, never held whole. The format is
 //! detected on its first [`PREFIX_BYTES`], then the csv reader runs over that
@@ -78,6 +80,8 @@ pub struct LogReader {
     time_scale: f64,
     disp_column: String,
     disp_scale: f64,
+    /// Sheet or group of a structured log (`.xlsx`, `.tdms`; see `ingest::formats`).
+    source: crate::ingest::formats::Source,
 }
 
 impl LogReader {
@@ -91,7 +95,13 @@ impl LogReader {
             time_scale: 1.0,
             disp_column: "disp_mm".into(),
             disp_scale: 1.0,
+            source: Default::default(),
         }
+    }
+    /// Sheet (`.xlsx`) or group (`.tdms`) holding the channels.
+    pub fn source(mut self, source: crate::ingest::formats::Source) -> Self {
+        self.source = source;
+        self
     }
     pub fn format(mut self, f: LogFormat) -> Self {
         self.format = f;
@@ -112,6 +122,9 @@ impl LogReader {
 
     /// Read the file, streamed (see the module docs).
     pub fn read(&self) -> Result<LogData, InputError> {
+        if let Some(kind) = crate::ingest::formats::Kind::of(&self.path) {
+            return crate::ingest::formats::read(kind, &self.request());
+        }
         let io = |source| InputError::Io {
             file: self.path.clone(),
             source,
@@ -128,6 +141,18 @@ impl LogReader {
         let mut prefix = Vec::new();
         (&mut f).take(PREFIX_BYTES as u64).read_to_end(&mut prefix).map_err(io)?;
         self.parse_stream(&prefix, f, size)
+    }
+
+    /// What a structured-format reader needs (`ingest::formats`).
+    fn request(&self) -> crate::ingest::formats::Request<'_> {
+        crate::ingest::formats::Request {
+            file: &self.path,
+            time_column: &self.time_column,
+            time_scale: self.time_scale,
+            disp_column: &self.disp_column,
+            disp_scale: self.disp_scale,
+            source: &self.source,
+        }
     }
 
     /// Parse the bytes of a log (the path only names it in messages).

@@ -116,6 +116,10 @@ struct RawChannels {
     time: Option<TimeChannel>,
     displacement: Option<DisplacementChannel>,
     outward_sign: Option<i64>,
+    /// Sheet of an `.xlsx` log (default: the first).
+    sheet: Option<String>,
+    /// Group of a `.tdms` log (default: the one holding the channel).
+    group: Option<String>,
 }
 
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -139,6 +143,8 @@ struct RawTest {
     channels: Option<RawChannels>,
     format: Option<RawFormat>,
     acquisition: Option<RawAcquisition>,
+    sheet: Option<String>,
+    group: Option<String>,
 }
 
 /// A validated test: every channel resolved.
@@ -154,6 +160,8 @@ pub struct TestSpec {
     /// +1 when a positive reading means outward, −1 when it means inward.
     pub outward_sign: f64,
     pub format: LogFormat,
+    /// Sheet (`.xlsx`) or group (`.tdms`) holding the channels.
+    pub source: crate::ingest::formats::Source,
     /// Lever arm of the sensor about the hinge, m (sensor height − hinge height).
     pub lever_arm_m: f64,
     /// The logger's filter: the test's own `acquisition`, else `[acquisition]`,
@@ -179,6 +187,9 @@ pub struct Campaign {
     pub e_housner: f64,
     pub e_housner_source: Provenance,
     pub tests: Vec<TestSpec>,
+    /// SHA-256 (hex) of the manifest's text: the key of its reductions in a lab's
+    /// archive (`rocklab archive`).
+    pub manifest_sha256: String,
 }
 
 impl Campaign {
@@ -210,7 +221,12 @@ impl Campaign {
     pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
         // A manifest drafted by `rocklab init` and not yet filled in.
         super::scaffold::check_filled(text, path)?;
-        validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))
+        let mut c = validate(parse_toml(text, path)?, path).map_err(|e| e.located(path, text))?;
+        c.manifest_sha256 = {
+            use sha2::{Digest, Sha256};
+            Sha256::digest(text.as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+        };
+        Ok(c)
     }
 }
 
@@ -452,9 +468,19 @@ fn validate_test(t: &RawTest, d: &Defaults, path: &Path) -> Result<TestSpec> {
         displacement,
         outward_sign,
         format,
+        source: test_source(t, d),
         lever_arm_m,
         acquisition,
     })
+}
+
+/// Sheet and group of one test: its own, then its nested `channels`, then the defaults.
+fn test_source(t: &RawTest, d: &Defaults) -> crate::ingest::formats::Source {
+    let nested = t.channels.as_ref();
+    crate::ingest::formats::Source {
+        sheet: t.sheet.clone().or(nested.and_then(|c| c.sheet.clone())).or(d.channels.sheet.clone()),
+        group: t.group.clone().or(nested.and_then(|c| c.group.clone())).or(d.channels.group.clone()),
+    }
 }
 
 fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
@@ -488,6 +514,7 @@ fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
         tests.push(validate_test(t, &defaults, path)?);
     }
     Ok(Campaign {
+        manifest_sha256: String::new(),
         name: raw.campaign.name,
         rocking: raw.campaign.rocking,
         manifest_path: path.to_path_buf(),
@@ -529,6 +556,21 @@ file = "b.csv"
 outward_sign = -1
 time = { column = "t_ms", unit = "ms" }
 "#;
+
+    #[test]
+    fn sheet_and_group_come_from_the_test_then_channels() {
+        let text = BASE
+            .replace("outward_sign = 1\n[[test]]", "outward_sign = 1\nsheet = \"log\"\ngroup = \"g\"\n[[test]]")
+            .replace("file = \"b.csv\"", "file = \"b.csv\"\nsheet = \"other\"");
+        let c = Campaign::parse(&text, Path::new("/x/campaign.toml")).unwrap();
+        assert_eq!(c.tests[0].source.sheet.as_deref(), Some("log"));
+        assert_eq!(c.tests[1].source.sheet.as_deref(), Some("other"));
+        assert_eq!(c.tests[1].source.group.as_deref(), Some("g"));
+        // The manifest's hash, the archive's key: SHA-256 of its text.
+        assert_eq!(c.manifest_sha256.len(), 64);
+        let other = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
+        assert_ne!(c.manifest_sha256, other.manifest_sha256);
+    }
 
     #[test]
     fn defaults_merge_with_overrides() {

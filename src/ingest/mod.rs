@@ -5,6 +5,7 @@
 
 pub mod block;
 pub mod calibration;
+pub mod formats;
 pub mod law;
 pub mod log;
 pub mod manifest;

@@ -109,6 +109,7 @@ pub fn physics(campaign: &Campaign, spec: &TestSpec) -> Physics {
 pub fn read_log(spec: &TestSpec) -> Result<LogData, InputError> {
     LogReader::new(&spec.file)
         .format(spec.format)
+        .source(spec.source.clone())
         .time(&spec.time.column, spec.time.unit.to_s())
         .displacement(&spec.displacement.column, spec.displacement.unit.to_mm() * spec.outward_sign)
         .read()

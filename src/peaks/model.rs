@@ -497,7 +497,7 @@ impl Model {
         let start = if k == 0 { self.release_time() } else { self.release_from_contact(k - 1) };
         let from = v_end_t - 0.25 * (v_end_t - start);
         let to = if k + 1 < self.m() { self.release_from_contact(k) } else { v_end_t };
-        let want = if k % 2 == 0 { -1.0 } else { 1.0 };
+        let want = if k.is_multiple_of(2) { -1.0 } else { 1.0 };
         // Half-cycle k lies on the outward side for k even.
         let side = -want;
         let mut best = (v_end_t, v_end);

@@ -43,6 +43,7 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
     }
     super::docs::gather_timing(&mut doc);
     files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
+    impacts_file(&doc, &mut files)?;
     let tabs = tables::tables(res);
     table_files(res, &tabs, &mut files)?;
     let figs: TestFigures = if with_plots {
@@ -66,12 +67,26 @@ pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, e
     Ok(files)
 }
 
+/// `impacts.parquet`: one row per impact of summary.json's tests, in the archive's
+/// layout (`rocklab::archive`), when the tests carry per-impact coefficients in
+/// SPEC's shape.
+fn impacts_file(doc: &serde_json::Value, files: &mut Files) -> Result<(), ReportError> {
+    let Ok(mut r) = crate::archive::rows::reduction(doc, "summary.json") else {
+        return Ok(()); // no manifest hash (unreadable manifest): no archive rows either
+    };
+    if r.impacts.height() > 0 {
+        files.add("impacts.parquet", super::parquet::bytes(&mut r.impacts)?);
+    }
+    Ok(())
+}
+
 /// Each table as `NAME.csv` and `NAME.md`, all of them in tables.md and tables.tex.
 fn table_files(res: &CampaignResult, tabs: &[Table], files: &mut Files) -> Result<(), ReportError> {
     let mut md = format!("# {} — coefficients of restitution\n\n", res.campaign.name);
     let mut tex = String::from("% Tables 1-3 written by rocklab (needs \\usepackage{booktabs})\n");
     for t in tabs {
         files.add(format!("{}.csv", t.name), tables::to_csv(t)?);
+        files.add(format!("{}.parquet", t.name), super::parquet::table(t)?);
         let one = tables::to_markdown(t);
         files.add(format!("{}.md", t.name), one.as_bytes());
         md.push_str(&one);

@@ -11,6 +11,7 @@ pub mod facade;
 pub mod finite;
 pub mod html;
 pub mod law;
+pub mod parquet;
 pub mod plots;
 pub mod quality;
 pub mod response;
@@ -29,6 +30,8 @@ pub enum ReportError {
     Plot(String),
     #[error("CSV: {0}")]
     Csv(#[from] csv::Error),
+    #[error("Parquet: {0}")]
+    Parquet(String),
     #[error("JSON: {0}")]
     Json(#[from] serde_json::Error),
     #[error("TOML: {0}")]

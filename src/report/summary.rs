@@ -214,5 +214,25 @@ pub fn summary(res: &CampaignResult) -> Result<Value, super::ReportError> {
         mean_left_out: res.means.left_out.iter().map(|(id, why)| LeftOut { id, why }).collect(),
         restitution_law: law_doc(&res.law),
     };
-    super::json_value(&doc)
+    let mut v = super::json_value(&doc)?;
+    if let Value::Object(m) = &mut v {
+        m.extend(identity(c));
+    }
+    Ok(v)
+}
+
+/// Keys that identify a reduction in a lab's archive (`rocklab archive`): the
+/// wall's size, the manifest's SHA-256 (the archive's key) and the rocklab version.
+fn identity(c: &crate::ingest::Campaign) -> serde_json::Map<String, Value> {
+    let mut m = serde_json::Map::new();
+    m.insert(
+        "wall".into(),
+        serde_json::json!({
+            "height_m": c.height_m, "thickness_m": c.thickness_m, "width_m": c.width_m,
+            "weight_kN": c.weight_kn, "hinge_height_m": c.hinge_height_m,
+        }),
+    );
+    m.insert("manifest_sha256".into(), c.manifest_sha256.clone().into());
+    m.insert("rocklab_version".into(), env!("CARGO_PKG_VERSION").into());
+    m
 }

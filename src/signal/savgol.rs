@@ -31,7 +31,7 @@ impl SavGol {
     /// `window` odd, 3 ≤ window ≤ 1001, `order` < `window` and ≤ 10 (issue 22:
     /// bounds under which the Vandermonde matrix stays finite and well scaled).
     pub fn new(window: usize, order: usize) -> Result<SavGol, SavGolError> {
-        if !(3..=1001).contains(&window) || window % 2 == 0 {
+        if !(3..=1001).contains(&window) || window.is_multiple_of(2) {
             return Err(SavGolError::Window { window });
         }
         if order >= window || order > 10 {

@@ -1,0 +1,132 @@
+//! `ARCHIVE/archive.html`: a self-contained page (SVG inline) plotting every
+//! archived test's r⁺ and r⁻ against the wall's slenderness h/t, by rocking type,
+//! each with its band r ± 2u (u: the test's standard uncertainty, `_u`), and a table
+//! of the campaigns.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use polars::prelude::*;
+
+use super::ArchiveError;
+use crate::report::html::Page;
+use crate::report::plots::{self, Panel, Series};
+
+/// One archived test, as the page needs it.
+struct Point {
+    campaign: String,
+    rocking: String,
+    slenderness: f64,
+    r_plus: (f64, Option<f64>),
+    r_minus: (f64, Option<f64>),
+}
+
+fn text(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<String>>> {
+    Ok(df.column(name)?.str()?.iter().map(|s| s.map(str::to_string)).collect())
+}
+
+fn numbers(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+    Ok(df.column(name)?.f64()?.iter().collect())
+}
+
+/// The plotted tests: status "ok", slenderness and both ratios known.
+fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
+    let (campaign, rocking, status) = (text(df, "campaign")?, text(df, "rocking")?, text(df, "status")?);
+    let (sl, rp, rpu, rm, rmu) = (
+        numbers(df, "slenderness")?,
+        numbers(df, "r_plus")?,
+        numbers(df, "r_plus_u")?,
+        numbers(df, "r_minus")?,
+        numbers(df, "r_minus_u")?,
+    );
+    let mut out = Vec::new();
+    for i in 0..df.height() {
+        if status[i].as_deref() != Some("ok") {
+            continue;
+        }
+        if let (Some(s), Some(p), Some(m)) = (sl[i], rp[i], rm[i]) {
+            out.push(Point {
+                campaign: campaign[i].clone().unwrap_or_default(),
+                rocking: rocking[i].clone().unwrap_or_default(),
+                slenderness: s,
+                r_plus: (p, rpu[i]),
+                r_minus: (m, rmu[i]),
+            });
+        }
+    }
+    let left_out = df.height() - out.len();
+    Ok((out, left_out))
+}
+
+/// One panel: dots by rocking type, an unlabelled bar r ± 2u per test.
+fn panel(points: &[Point], title: &str, y_label: &str, pick: fn(&Point) -> (f64, Option<f64>)) -> Panel {
+    let colors = [("one-sided", plots::BLUE), ("two-sided", plots::ORANGE)];
+    let mut series = Vec::new();
+    for (rocking, color) in colors {
+        let pts: Vec<&Point> = points.iter().filter(|p| p.rocking == rocking).collect();
+        for p in &pts {
+            if let (v, Some(u)) = pick(p) {
+                series.push(Series::line("", color, vec![(p.slenderness, v - 2.0 * u), (p.slenderness, v + 2.0 * u)]));
+            }
+        }
+        if !pts.is_empty() {
+            series.push(Series::dots(
+                &format!("{rocking} rocking"),
+                color,
+                pts.iter().map(|p| (p.slenderness, pick(p).0)).collect(),
+            ));
+        }
+    }
+    let mut panel = Panel::new(title, "slenderness h/t", y_label, series);
+    let xs: Vec<f64> = points.iter().map(|p| p.slenderness).collect();
+    let (lo, hi) = xs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+    if lo.is_finite() {
+        let pad = ((hi - lo) * 0.1).max(0.5);
+        panel.x_range = Some((lo - pad, hi + pad));
+    }
+    panel
+}
+
+/// Render the page from the `tests` table.
+pub fn render(tests: &DataFrame) -> Result<String, ArchiveError> {
+    let (pts, left_out) = points(tests).map_err(|e| ArchiveError::Page(e.to_string()))?;
+    let mut page = Page::new("Lab archive — coefficients of restitution of every campaign");
+    page.p(&format!(
+        "{} tests plotted (status ok); {left_out} left out (suspect, error, or without r⁺/r⁻ or the wall's size). Bars: r ± 2u, u the test's standard uncertainty. Ratios r = e/e_H (paper Eqs. 5–6).",
+        pts.len()
+    ));
+    let panels = [
+        panel(&pts, "r⁺ (outward) against slenderness", "r⁺", |p| p.r_plus),
+        panel(&pts, "r⁻ (inward) against slenderness", "r⁻", |p| p.r_minus),
+    ];
+    let fig = plots::render(&panels, 900, 380).map_err(|e| ArchiveError::Page(e.to_string()))?;
+    page.figure(&fig.svg, "Every archived test's r⁺ and r⁻ with its band (± 2u), by rocking type.");
+    let mut by: BTreeMap<(String, String), Vec<&Point>> = BTreeMap::new();
+    for p in &pts {
+        by.entry((p.campaign.clone(), p.rocking.clone())).or_default().push(p);
+    }
+    let mean = |v: &[&Point], f: fn(&Point) -> f64| v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64;
+    let rows: Vec<Vec<String>> = by
+        .iter()
+        .map(|((c, r), v)| {
+            vec![
+                c.clone(),
+                r.clone(),
+                format!("{:.2}", v[0].slenderness),
+                v.len().to_string(),
+                format!("{:.3}", mean(v, |p| p.r_plus.0)),
+                format!("{:.3}", mean(v, |p| p.r_minus.0)),
+            ]
+        })
+        .collect();
+    page.h2("Campaigns");
+    page.table("meta", &["campaign", "rocking", "h/t", "tests ok", "mean r⁺", "mean r⁻"], &rows);
+    Ok(page.finish())
+}
+
+/// Write `archive.html` (atomically).
+pub fn write(archive: &Path, tests: &DataFrame) -> Result<(), ArchiveError> {
+    let mut files = crate::report::Files::default();
+    files.add("archive.html", render(tests)?);
+    crate::report::write_files(archive, &files).map_err(|e| ArchiveError::Write(e.to_string()))
+}

@@ -1,0 +1,206 @@
+//! Issue #19: the lab archive. `rocklab archive add` of both demo reductions,
+//! twice, holds 10 test rows without duplicates, equal to summary.json;
+//! `archive query` answers SQL; a crash between the two tables' writes leaves a
+//! readable, consistent archive; impacts in SPEC's shape become impacts.parquet rows.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use polars::prelude::*;
+use rocklab::archive::{self, ArchiveError, Step};
+use serde_json::{json, Value};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_rocklab")
+}
+
+fn run(args: &[&str]) -> String {
+    let out = Command::new(bin()).args(args).output().unwrap();
+    let (so, se) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "rocklab {args:?} failed:\n{so}\n{se}");
+    so.into_owned()
+}
+
+/// Reduce a demo campaign into `out` (no plots: the tables are what is archived).
+fn reduce(campaign: &str, out: &Path) -> Value {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/campaigns")
+        .join(campaign)
+        .join("campaign.toml");
+    run(&["reduce", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-plots"]);
+    // Numbers read exactly (serde_json as built here may be one ulp off); Python's
+    // json, an independent reader, checks the same in python/tests/test_archive.py.
+    archive::json::parse(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
+fn strs(df: &DataFrame, c: &str) -> Vec<String> {
+    df.column(c).unwrap().str().unwrap().iter().map(|s| s.unwrap_or("").to_string()).collect()
+}
+
+fn nums(df: &DataFrame, c: &str) -> Vec<Option<f64>> {
+    df.column(c).unwrap().f64().unwrap().iter().collect()
+}
+
+#[test]
+fn add_twice_query_and_values_equal_summary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (one, two, arc) = (tmp.path().join("one"), tmp.path().join("two"), tmp.path().join("archive"));
+    let docs = [reduce("one-sided-demo", &one), reduce("two-sided-demo", &two)];
+    for doc in &docs {
+        assert_eq!(doc["manifest_sha256"].as_str().unwrap().len(), 64);
+        assert!(doc["wall"]["height_m"].as_f64().is_some());
+    }
+    // The tables' Parquet copies sit beside the CSVs.
+    for t in ["table1", "table2", "table3"] {
+        assert!(one.join(format!("{t}.parquet")).exists(), "{t}.parquet missing");
+    }
+    let (a, b, z) = (one.to_str().unwrap(), two.to_str().unwrap(), arc.to_str().unwrap());
+    run(&["archive", "add", a, b, "--to", z]);
+    let second = run(&["archive", "add", a, b, "--to", z]);
+    assert!(second.contains("replacing 5 earlier rows"), "{second}");
+    let (tests, impacts) = archive::load(&arc).unwrap();
+    assert_eq!(tests.height(), 10, "{tests}");
+    let keys: BTreeSet<(String, String)> = strs(&tests, "manifest_sha256").into_iter().zip(strs(&tests, "test")).collect();
+    assert_eq!(keys.len(), 10, "duplicate rows");
+    // Every value equal to summary.json's (the same f64, through Parquet).
+    let (campaigns, ids) = (strs(&tests, "campaign"), strs(&tests, "test"));
+    for doc in &docs {
+        for t in doc["tests"].as_array().unwrap() {
+            let i = (0..tests.height())
+                .find(|&i| campaigns[i] == doc["campaign"].as_str().unwrap() && ids[i] == t["id"].as_str().unwrap())
+                .unwrap();
+            assert_eq!(strs(&tests, "status")[i], t["status"].as_str().unwrap());
+            for v in archive::TABLE_VALUES {
+                for k in [v.to_string(), format!("{v}_u")] {
+                    assert_eq!(nums(&tests, &k)[i], t[&k].as_f64(), "{} {} {k}", campaigns[i], ids[i]);
+                }
+            }
+            assert_eq!(nums(&tests, "e_housner")[i], doc["e_housner"].as_f64());
+            let slender = doc["wall"]["height_m"].as_f64().unwrap() / doc["wall"]["thickness_m"].as_f64().unwrap();
+            assert_eq!(nums(&tests, "slenderness")[i], Some(slender));
+        }
+    }
+    // The demo summaries' impacts are not (yet) in SPEC's per-impact shape: no rows.
+    assert_eq!(impacts.height(), 0);
+    let out = run(&[
+        "archive",
+        "query",
+        z,
+        "SELECT campaign, count(*) AS n, avg(r_plus) AS r_plus FROM tests GROUP BY campaign ORDER BY campaign",
+    ]);
+    assert!(out.contains("one-sided-demo") && out.contains("two-sided-demo"), "{out}");
+    assert!(out.contains("(2 rows)"), "{out}");
+    let df = archive::query(&arc, "SELECT count(*) AS n FROM tests WHERE campaign = 'one-sided-demo'").unwrap();
+    assert_eq!(df.column("n").unwrap().cast(&DataType::Int64).unwrap().i64().unwrap().get(0), Some(5));
+    // The archive page plots them.
+    let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
+    assert!(page.contains("<svg") && page.contains("one-sided-demo") && page.contains("two-sided-demo"));
+    // A bad query is an error, not a crash.
+    let e = archive::query(&arc, "SELECT nope FROM tests").unwrap_err();
+    assert!(matches!(e, ArchiveError::Sql(_)), "{e}");
+}
+
+/// A summary of `n_tests` tests whose impacts are in SPEC's shape (k, side,
+/// amplitude_over_alpha, speeds, e, e_u, r, r_u), keyed by `sha`.
+fn spec_summary(sha: &str, n_tests: usize, n_impacts: usize) -> Value {
+    let tests: Vec<Value> = (0..n_tests)
+        .map(|t| {
+            let impacts: Vec<Value> = (0..n_impacts)
+                .map(|k| {
+                    json!({"k": k, "side": if k % 2 == 0 { "in" } else { "out" }, "amplitude_over_alpha": 0.5 / (k + 1) as f64,
+                           "speed_before_mm_s": 600.0 - 50.0 * k as f64, "speed_after_mm_s": 390.0 - 30.0 * k as f64,
+                           "e": 0.65, "e_u": 0.006, "r": 0.668 + 0.001 * t as f64, "r_u": 0.006})
+                })
+                .collect();
+            json!({"id": format!("T{t}"), "status": "ok", "r_plus": 0.7, "r_minus": 0.6, "r_plus_u": 0.01, "r_minus_u": 0.01,
+                   "exclude_from_mean": false, "impacts": impacts})
+        })
+        .collect();
+    json!({"campaign": format!("c-{sha}"), "rocking": "one-sided", "alpha_rad": 0.13, "e_housner": 0.97,
+           "manifest_sha256": sha, "rocklab_version": "0", "wall": {"height_m": 2.7, "thickness_m": 0.36},
+           "tests": tests})
+}
+
+fn write_summary(dir: &Path, doc: &Value) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(dir.join("summary.json"), serde_json::to_vec(doc).unwrap()).unwrap();
+    dir.to_path_buf()
+}
+
+#[test]
+fn impacts_in_spec_shape_become_rows() {
+    let tmp = tempfile::tempdir().unwrap();
+    let r = write_summary(&tmp.path().join("r"), &spec_summary("aa", 3, 7));
+    let arc = tmp.path().join("arc");
+    let added = archive::add(&arc, &[r]).unwrap();
+    assert_eq!((added.tests_rows, added.impacts_rows), (3, 21));
+    let (_, impacts) = archive::load(&arc).unwrap();
+    assert_eq!(impacts.height(), 21);
+    assert_eq!(strs(&impacts, "side")[..3], ["in", "out", "in"]);
+    assert_eq!(nums(&impacts, "r")[7], Some(0.669)); // test T1, impact 0
+    let df = archive::query(
+        &arc,
+        "SELECT test, count(*) AS n FROM impacts WHERE side = 'in' GROUP BY test ORDER BY test",
+    )
+    .unwrap();
+    assert_eq!(strs(&df, "test"), ["T0", "T1", "T2"]);
+}
+
+/// (tests rows, impacts rows, the shas in each) of an archive as a reader finds it.
+fn state(arc: &Path) -> (usize, usize, BTreeSet<String>, BTreeSet<String>) {
+    let (t, i) = archive::load(arc).unwrap();
+    let shas = |df: &DataFrame| strs(df, "manifest_sha256").into_iter().collect::<BTreeSet<_>>();
+    (t.height(), i.height(), shas(&t), shas(&i))
+}
+
+#[test]
+fn a_crash_between_the_two_writes_leaves_a_consistent_archive() {
+    for crash_at in [Step::Staged, Step::FirstRenamed] {
+        let tmp = tempfile::tempdir().unwrap();
+        let arc = tmp.path().join("arc");
+        let old = write_summary(&tmp.path().join("old"), &spec_summary("aa", 2, 4));
+        archive::add(&arc, &[old]).unwrap();
+        assert_eq!(state(&arc).0, 2);
+        // A re-reduction of the same manifest (5 tests, 6 impacts each), then a second
+        // campaign, the add "crashing" at `crash_at`: the hook's error stops it there
+        // and nothing is cleaned up, as after a kill.
+        let new = write_summary(&tmp.path().join("new"), &spec_summary("aa", 5, 6));
+        let other = write_summary(&tmp.path().join("other"), &spec_summary("bb", 1, 2));
+        let mut hook = |s: Step| {
+            if s == crash_at {
+                Err(ArchiveError::Page("injected crash".into()))
+            } else {
+                Ok(())
+            }
+        };
+        assert!(archive::add_with_hook(&arc, &[new, other], &mut hook).is_err());
+        // Right after the crash the files are those of one state or the other only
+        // once a reader has recovered; every reader recovers first.
+        let (nt, ni, st, si) = state(&arc);
+        match crash_at {
+            // Not committed: the old archive, whole.
+            Step::Staged => assert_eq!((nt, ni), (2, 8), "{crash_at:?}"),
+            // Committed: the new archive, whole (5 + 1 tests, 30 + 2 impacts).
+            Step::FirstRenamed => assert_eq!((nt, ni), (6, 32), "{crash_at:?}"),
+        }
+        assert_eq!(st, si, "{crash_at:?}: the two tables hold different reductions");
+        assert!(!arc.join(".pending").exists());
+        // And the archive takes the next add as usual.
+        let again = write_summary(&tmp.path().join("again"), &spec_summary("aa", 3, 1));
+        let added = archive::add(&arc, &[again]).unwrap();
+        assert_eq!(added.tests_rows, nt - if crash_at == Step::Staged { 2 } else { 5 } + 3);
+    }
+}
+
+#[test]
+fn a_summary_without_the_manifest_hash_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut doc = spec_summary("aa", 1, 1);
+    doc.as_object_mut().unwrap().remove("manifest_sha256");
+    let r = write_summary(&tmp.path().join("r"), &doc);
+    let e = archive::add(&tmp.path().join("arc"), &[r]).unwrap_err().to_string();
+    assert!(e.contains("summary.json: no 'manifest_sha256'"), "{e}");
+    let e = archive::query(&tmp.path().join("nothing"), "SELECT 1").unwrap_err().to_string();
+    assert!(e.contains("no archive here"), "{e}");
+}

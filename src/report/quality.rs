@@ -99,7 +99,7 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::ImpactResiduals => Advice {
             title: "The log around an impact is not where the fit puts it.",
             look: "the displacement panel of the motion plot, zoomed on the impact named.",
-            how_far: "On 200 synthetic tests with compliant contacts, the 14 flagged for this were off by 2.33 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
+            how_far: "On 200 synthetic tests with compliant contacts, the 13 flagged for this were off by 2.33 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
             rerun: "look for a spike or a dropout near the impact in the raw log; a higher logging rate helps.",
         },
         Kind::Disagreement => Advice {
@@ -117,7 +117,7 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::ContactOvershoot => Advice {
             title: "Inside a contact the fitted speed overshoots the free swing: the contact model does not fit this impact.",
             look: "the velocity panel of the motion plot at the peak named: is the blue curve above the grey one?",
-            how_far: "On 200 synthetic tests with compliant contacts, the 7 flagged for this were off by 2.33 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
+            how_far: "On 200 synthetic tests with compliant contacts, the 6 flagged for this were off by 3.04 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
             rerun: "compare with rocklab reduce --method savgol; a higher logging rate resolves the contact.",
         },
         Kind::ZeroReadings => Advice {

@@ -743,6 +743,15 @@ fn init_then_fill_in_then_reduce_gives_the_demos_numbers() {
     // The same tests in another order (init sorts the files by name): every value
     // equal, the means to 1e-12 (their sums run in the tests' order).
     let by_id = |mut s: Value| {
+        // The two manifests' texts differ, so do their hashes (issue 19's archive key).
+        s.as_object_mut().unwrap().remove("manifest_sha256");
+        // Width and weight are optional and unused by the reduction; init does not ask for them.
+        for k in ["width_m", "weight_kN"] {
+            s["wall"].as_object_mut().map(|w| w.remove(k));
+        }
+        if let Some(t) = s["restitution_law"]["tests"].as_array_mut() {
+            t.sort_by_key(|t| t.as_str().unwrap().to_string());
+        }
         s["tests"].as_array_mut().unwrap().sort_by_key(|t| t["id"].as_str().unwrap().to_string());
         s["mean_included"]
             .as_array_mut()

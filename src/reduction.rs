@@ -31,7 +31,7 @@ pub struct Reduced {
     pub uncertainty: Option<Coefficients>,
     /// Every impact the log resolves ([`resolve_impacts`]; empty until it runs).
     pub impacts: ImpactTable,
-    /// How many peaks the analysis behind `impacts` fitted (`impacts` has one fewer).
+    /// How many peaks `impacts` comes from, the late local readings included (`impacts` has one fewer).
     pub impact_peaks: usize,
 }
 

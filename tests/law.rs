@@ -555,6 +555,7 @@ fn law_form_against_the_engine_truth() {
             assert!(law_rms <= 0.02 && law_rms < cst_rms, "{law_rms:.4} vs constant {cst_rms:.4}");
         }
         if name == "mujoco-public-one-sided" {
+            truth_law_fixture(&fit);
             let out: Vec<&Listed> = listed.iter().filter(|l| l.2 == Side::Outward).collect();
             let mean = out.iter().map(|l| l.4).sum::<f64>() / out.len() as f64;
             let cst_out = rms(&out.iter().map(|l| mean - l.4).collect::<Vec<_>>());
@@ -564,4 +565,34 @@ fn law_form_against_the_engine_truth() {
     }
     println!("worst extrapolation on the falling groups: speed-loss {worst_q1:.3}, free exponent {worst_free:.3}");
     assert!(worst_q1 < worst_free, "{worst_q1:.3} vs {worst_free:.3}");
+}
+
+/// `fixtures/laws/mujoco-public-one-sided-truth.json`, the law `rocklab demo` carries
+/// into the façade beside the campaign's own (docs/facade.md): rocklab's law fitted to
+/// the engine's per-impact truth of mujoco-public-one-sided (what the readings would
+/// give if they reached every listed impact), with its constant pair. Checked here
+/// against the fit to 1e-9; `ROCKLAB_WRITE_TRUTH_LAW=1` rewrites it.
+fn truth_law_fixture(fit: &rocklab::law_fit::LawFit) {
+    let c = &fit.constant.parameters;
+    let mut law = serde_json::to_value(fit.law).unwrap();
+    law["constant"] = serde_json::json!({
+        "r_in": c.inward.r_inf, "r_in_u": c.inward.cov[0][0].sqrt(),
+        "r_out": c.outward.r_inf, "r_out_u": c.outward.cov[0][0].sqrt(),
+    });
+    law["notes"] = serde_json::json!(fit.notes);
+    let doc = serde_json::json!({
+        "source": "rocklab's law (src/law_fit.rs) fitted to the per-impact truth (e_true, every listed impact) of fixtures/campaigns/mujoco-public-one-sided, u = 0.002 g(a); written by tests/law.rs law_form_against_the_engine_truth",
+        "restitution_law": law,
+    });
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/laws/mujoco-public-one-sided-truth.json");
+    if std::env::var("ROCKLAB_WRITE_TRUTH_LAW").is_ok() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, serde_json::to_string_pretty(&doc).unwrap() + "\n").unwrap();
+    }
+    let stored = rocklab::ingest::law::read(&path).unwrap();
+    let (a, b) = (stored.parameters, fit.law.parameters);
+    for (x, y) in [(a.inward, b.inward), (a.outward, b.outward)] {
+        assert!((x.r_inf - y.r_inf).abs() < 1e-9 && (x.c - y.c).abs() < 1e-9, "{x:?} vs {y:?}");
+    }
+    assert_eq!(stored.form, fit.law.form);
 }

@@ -6,28 +6,28 @@ use std::path::PathBuf;
 /// A defect in a log file or a manifest, located to the line and column.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
-    #[error("{file}: cannot read: {source}")]
+    #[error("{}: cannot read: {source}", shown(file))]
     Io {
         file: PathBuf,
         #[source]
         source: std::io::Error,
     },
-    #[error("{file}: file not found (expected a log exported by the data-acquisition system)")]
+    #[error("{}: file not found (expected a log exported by the data-acquisition system)", shown(file))]
     Missing { file: PathBuf },
-    #[error("{file}: the file is empty (expected '#' metadata lines, a header row and numeric rows)")]
+    #[error("{}: the file is empty (expected '#' metadata lines, a header row and numeric rows)", shown(file))]
     Empty { file: PathBuf },
-    #[error("{file}:{line}: header row without data (expected numeric rows after the header)")]
+    #[error("{}:{line}: header row without data (expected numeric rows after the header)", shown(file))]
     NoData { file: PathBuf, line: u64 },
-    #[error("{file}:{line}:{column}: {message}")]
+    #[error("{}:{line}:{column}: {message}", shown(file))]
     At {
         file: PathBuf,
         line: u64,
         column: usize,
         message: String,
     },
-    #[error("{file}:{line}: {message}")]
+    #[error("{}:{line}: {message}", shown(file))]
     Line { file: PathBuf, line: u64, message: String },
-    #[error("{file}: {message}")]
+    #[error("{}: {message}", shown(file))]
     File { file: PathBuf, message: String },
 }
 
@@ -72,9 +72,9 @@ impl std::fmt::Display for FileKind {
 /// every variant names the file; a parse error also its line and column.
 #[derive(Debug, thiserror::Error)]
 pub enum FileError {
-    #[error("{}: {kind} not found", file.display())]
+    #[error("{}: {kind} not found", shown(file))]
     NotFound { file: PathBuf, kind: FileKind },
-    #[error("{}: cannot read {kind}: {source}", file.display())]
+    #[error("{}: cannot read {kind}: {source}", shown(file))]
     Io {
         file: PathBuf,
         kind: FileKind,
@@ -83,7 +83,7 @@ pub enum FileError {
     },
     /// Not TOML, an unknown key, a missing key or a wrong type (the parser's
     /// message, which shows the line).
-    #[error("{}: {message}", file.display())]
+    #[error("{}: {message}", shown(file))]
     Toml {
         file: PathBuf,
         /// 1-based line and column of the defect, when the parser located it.
@@ -109,8 +109,8 @@ pub enum FileError {
 /// "file:line:column", or "file" when the place is not known.
 fn place(file: &std::path::Path, line: Option<usize>, column: Option<usize>) -> String {
     match (line, column) {
-        (Some(l), Some(c)) => format!("{}:{l}:{c}", file.display()),
-        _ => file.display().to_string(),
+        (Some(l), Some(c)) => format!("{}:{l}:{c}", shown(file)),
+        _ => shown(file),
     }
 }
 
@@ -211,6 +211,20 @@ pub fn excerpt(value: &str, max: usize) -> String {
     }
 }
 
+/// A path as a message shows it: whole up to 300 characters, else its first and
+/// last 120 with the length (issue 22: a mutated name of 4,000 characters made a
+/// message of 4,000; the start and the file name are what a reader needs).
+pub fn shown(path: &std::path::Path) -> String {
+    let text = path.display().to_string();
+    let n = text.chars().count();
+    if n <= 300 {
+        return text;
+    }
+    let head: String = text.chars().take(120).collect();
+    let tail: String = text.chars().skip(n - 120).collect();
+    format!("{head}…{tail} (a path of {n} characters)")
+}
+
 /// At most `max` characters of a message (newlines kept), with "…" when cut.
 pub fn excerpt_text(text: &str, max: usize) -> String {
     match text.char_indices().nth(max) {
@@ -222,6 +236,23 @@ pub fn excerpt_text(text: &str, max: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_path_is_shown_by_its_ends() {
+        let long = format!("/tmp/study/{}/block.toml", "7".repeat(3917));
+        let m = FileError::NotFound {
+            file: long.clone().into(),
+            kind: FileKind::Block,
+        }
+        .to_string();
+        assert!(m.chars().count() < 320, "{} characters", m.chars().count());
+        assert!(
+            m.starts_with("/tmp/study/777") && m.contains("7/block.toml (a path of 3939 characters): block file not found"),
+            "{m}"
+        );
+        let short = InputError::Missing { file: "a/b.csv".into() }.to_string();
+        assert!(short.starts_with("a/b.csv: file not found"), "{short}");
+    }
 
     const TEXT: &str = "[campaign]\nname = \"c\"\n[wall]\nheight_m = 2.7\n  thickness_m = -0.36\n[[test]]\nid = \"a\"\n[[test]]\nid = \"b\"\n";
 

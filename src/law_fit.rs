@@ -74,6 +74,13 @@ pub struct SideFit {
     pub constant_u: f64,
     pub statistic: f64,
     pub p_value: f64,
+    /// The amplitudes a = |θ|/α of this side's impacts: where its law is vouched for.
+    pub amplitude_min: f64,
+    pub amplitude_max: f64,
+    /// The change of r the speed-loss fit gives across them,
+    /// c (g(a_min) − g(a_max)), and its u: the trend the data could show there.
+    pub trend: f64,
+    pub trend_u: f64,
 }
 
 /// The campaign's law and its test against a constant.
@@ -91,6 +98,9 @@ pub struct LawFit {
     /// The best constant pair (the weighted constant of each side).
     pub constant: RestitutionLaw,
     pub tests_used: Vec<String>,
+    /// What the law cannot vouch for, per side ([`notes`]): the amplitudes it was
+    /// fitted on, why a side keeps the constant, where it extrapolates.
+    pub notes: Vec<String>,
 }
 
 /// Why no law could be fitted.
@@ -205,6 +215,7 @@ fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Resu
     };
     let cov = [[inv[(0, 0)] * scale, inv[(0, 1)] * scale], [inv[(1, 0)] * scale, inv[(1, 1)] * scale]];
     let c_scale = (chi2_c / (law.n - 1) as f64).max(1.0);
+    let trend_u = g_span * cov[1][1].sqrt();
     let side = SideLaw {
         r_inf: beta[0],
         c: beta[1],
@@ -220,6 +231,10 @@ fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Resu
         constant_u: (inv_c[(0, 0)] * c_scale).sqrt(),
         statistic,
         p_value,
+        amplitude_min: law.a_min,
+        amplitude_max: law.a_max,
+        trend: beta[1] * g_span,
+        trend_u,
     };
     Ok((side, fit, (law.a_min, law.a_max)))
 }
@@ -282,14 +297,56 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
             SideLaw::constant(fout.constant_r, fout.constant_u),
         ),
     };
+    let sides: Vec<(String, SideFit)> = fitted.iter().map(|f| (f.0.to_string(), f.1 .1)).collect();
+    let kept: Vec<bool> = (0..fitted.len()).map(keeps).collect();
     Ok(LawFit {
         rejects_constant: rejects,
-        sides: fitted.iter().map(|f| (f.0.to_string(), f.1 .1)).collect(),
+        notes: notes(&sides, &kept, level),
+        sides,
         law,
         speed_loss,
         constant,
         tests_used: tests.iter().filter(|t| t.table.r_cov.is_some()).map(|t| t.id.to_string()).collect(),
     })
+}
+
+/// What the law of each side cannot vouch for, in words for the report and
+/// summary.json (`restitution_law.notes`): a side that keeps the speed-loss form
+/// extrapolates below and above the amplitudes it was fitted on (bounded: r ≥ 0,
+/// e ≤ 1, g(1) = 1); a side that keeps the constant says why (the data do not reject
+/// it, and how large a trend they could have shown over how narrow a range; or the
+/// fitted speed loss is negative) and that below its smallest amplitude the constant
+/// is not vouched for: with compliant contacts r falls as the amplitude falls
+/// (docs/restitution-law.md), and data that stop early cannot show it.
+pub fn notes(sides: &[(String, SideFit)], kept: &[bool], level: f64) -> Vec<String> {
+    sides
+        .iter()
+        .zip(kept)
+        .map(|((name, f), &keeps)| {
+            let range = format!("{} impacts over a = {:.4}–{:.3}", f.impacts, f.amplitude_min, f.amplitude_max);
+            if keeps {
+                return format!(
+                    "side {name}: speed-loss law fitted on {range}; below a = {:.4} and above a = {:.3} it is extrapolated",
+                    f.amplitude_min, f.amplitude_max
+                );
+            }
+            let why = if f.p_value >= level {
+                format!(
+                    "the data do not reject a constant (p = {:.2}): the speed-loss fit puts r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}, a trend the impacts' scatter cannot tell from none",
+                    f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
+                )
+            } else {
+                format!(
+                    "the data reject a constant (p = {:.1e}) but the fitted speed loss is negative (r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}: rising as the amplitude falls), which the form does not describe",
+                    f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
+                )
+            };
+            format!(
+                "side {name}: constant r = {:.4} ± {:.4} from {range}; {why}; below a = {:.4} the constant is not vouched for",
+                f.constant_r, f.constant_u, f.amplitude_min
+            )
+        })
+        .collect()
 }
 
 /// P(χ²(1) > x) = erfc(√(x/2)).
@@ -418,6 +475,14 @@ mod tests {
         let p = fit.law.parameters.inward;
         assert!((p.r_inf - 1.02).abs() < 1e-9 && (p.c - 0.03).abs() < 1e-9, "{p:?}");
         assert!(fit.rejects_constant, "{:?}", fit.sides);
+        // The note flags where the law extrapolates; the trend is c (g(a_min) − g(a_max)).
+        assert!(
+            fit.notes[0].contains("below a = 0.0200 and above a = 0.300 it is extrapolated"),
+            "{:?}",
+            fit.notes
+        );
+        let f = fit.sides[0].1;
+        assert!((f.trend - 0.03 * (speed_shape(0.02) - speed_shape(0.3))).abs() < 1e-9, "{f:?}");
         // A constant 0.9 with ±0.01 alternating scatter: no trend, the constant stands.
         let pts: Vec<(f64, f64, Side)> = amps
             .iter()
@@ -430,6 +495,19 @@ mod tests {
         assert!((fit.constant.parameters.inward.r_inf - 0.9).abs() < 0.005);
         // The band covers the scatter: s² = χ²/ν > 1 scales it.
         assert!(fit.sides[0].1.scale > 1.0);
+        // The report says why the constant stands and that it is not vouched for
+        // below the data.
+        let note = &fit.notes[0];
+        assert!(
+            note.contains("do not reject") && note.contains("below a = 0.0200 the constant is not vouched for"),
+            "{note}"
+        );
+        // A rising r (c < 0) keeps the constant, and says so.
+        let pts: Vec<(f64, f64, Side)> = amps.iter().map(|&a| (a, 0.60 + 0.03 * speed_shape(a), Side::Inward)).collect();
+        let t = table(&pts, 0.003);
+        let fit = fit_law(Rocking::TwoSided, &[TestImpacts { id: "a", table: &t }]).unwrap();
+        assert!(fit.rejects_constant && fit.law.form == LawForm::Constant);
+        assert!(fit.notes[0].contains("negative"), "{:?}", fit.notes);
     }
 
     #[test]

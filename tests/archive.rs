@@ -29,9 +29,9 @@ fn reduce(campaign: &str, out: &Path) -> Value {
         .join(campaign)
         .join("campaign.toml");
     run(&["reduce", manifest.to_str().unwrap(), "--out", out.to_str().unwrap(), "--no-plots"]);
-    // Numbers read exactly (serde_json as built here may be one ulp off); Python's
+    // Numbers read exactly (serde_json's float_roundtrip, checked below); Python's
     // json, an independent reader, checks the same in python/tests/test_archive.py.
-    archive::json::parse(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+    serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
 }
 
 fn strs(df: &DataFrame, c: &str) -> Vec<String> {
@@ -203,4 +203,12 @@ fn a_summary_without_the_manifest_hash_is_refused() {
     assert!(e.contains("summary.json: no 'manifest_sha256'"), "{e}");
     let e = archive::query(&tmp.path().join("nothing"), "SELECT 1").unwrap_err().to_string();
     assert!(e.contains("no archive here"), "{e}");
+}
+
+/// summary.json is read back exactly: serde_json is built with `float_roundtrip`
+/// (Cargo.toml); without it this 17-digit value lands one ulp off.
+#[test]
+fn summary_numbers_are_read_exactly() {
+    let v: serde_json::Value = serde_json::from_str(r#"{"a": 0.014936020564324741}"#).unwrap();
+    assert_eq!(v["a"].as_f64(), Some("0.014936020564324741".parse::<f64>().unwrap()));
 }

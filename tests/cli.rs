@@ -249,7 +249,9 @@ fn format_invariance() {
 /// Issue 10: and the façade's P(overturn) table for Housner, the paper's pair and
 /// this campaign's calibration, with the fragility plot (small ensembles: debug
 /// build). Issue 20: and, for each one-sided campaign (the demo's own and
-/// mujoco-public-one-sided), its restitution law and its constant pair as sets.
+/// mujoco-public-one-sided), its restitution law and its constant pair as sets,
+/// and the law fitted to that campaign's per-impact truth (fixtures/laws/) with its
+/// constant pair.
 #[test]
 fn demo_writes_tables_and_plots() {
     let dir = tempfile::tempdir().unwrap();
@@ -281,6 +283,8 @@ fn demo_writes_tables_and_plots() {
             sets.push(constant);
         }
     }
+    // The truth's law is a speed-loss law outward (tests/law.rs): both its sets run.
+    sets.extend(["mujoco truth law", "mujoco truth constant"]);
     assert_eq!(rows.len(), 3 * 2 * sets.len(), "records × polarities × sets");
     for &set in &sets {
         assert!(rows.iter().any(|r| r["coefficients"] == set), "{set}");

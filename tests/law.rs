@@ -124,7 +124,10 @@ fn law_against_truth(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
 /// is fitted to all of them: 0.0235 over all 40 (0.032 before, 0.016 inside the
 /// amplitudes 0.041–0.36 it was then fitted to; the small impacts fall faster than
 /// the form follows): docs/restitution-law.md.
+/// Ignored (minutes in a debug build): run with
+/// `cargo test --release --test law -- --ignored --nocapture`.
 #[test]
+#[ignore]
 fn mujoco_two_sided_impacts_and_law() {
     let (res, truth) = reduce("mujoco-public-two-sided");
     let (rms_r, coverage, z) = per_impact(&res, &truth);
@@ -142,8 +145,13 @@ fn mujoco_two_sided_impacts_and_law() {
 /// of the truth. The first five impacts of each test are all the estimator resolves
 /// here (longer fits turn suspect), and over them the data do not reject a constant
 /// on either side: the law is then the constant pair, and it is printed against the
-/// truth (docs/restitution-law.md).
+/// truth (docs/restitution-law.md). Why the outward law is the constant: the
+/// readings are unbiased within their u, but they are 8 impacts over a = 0.013–0.034
+/// with u 0.016–0.09, as large as the whole change of the true r there; asserted:
+/// the report says the outward constant is not vouched for below the readings.
+/// Ignored as the two-sided one.
 #[test]
+#[ignore]
 fn mujoco_one_sided_impacts_and_law() {
     let (res, truth) = reduce("mujoco-public-one-sided");
     let (rms_r, coverage, z) = per_impact(&res, &truth);
@@ -153,6 +161,35 @@ fn mujoco_one_sided_impacts_and_law() {
         100.0 * coverage
     );
     assert!(rms_r <= 0.015, "per-impact RMS {rms_r:.4}");
+    let fit = res.law.as_ref().unwrap();
+    for (side, f) in &fit.sides {
+        println!("one-sided {side}: {f:?}");
+    }
+    let listed = truth_impacts(&res, &truth);
+    let mut errs = Vec::new();
+    for t in &res.tests {
+        for i in t.result.as_ref().unwrap().impacts.impacts.iter().filter(|i| i.side == Side::Outward) {
+            if let Some(l) = listed.iter().find(|l| l.0 == t.spec.id && l.1 == i.k) {
+                errs.push((i.r - l.3, i.r_u.unwrap()));
+            }
+        }
+    }
+    let mean = errs.iter().map(|e| e.0).sum::<f64>() / errs.len() as f64;
+    println!(
+        "one-sided outward readings against the truth: {} impacts, mean error {mean:+.4}, RMS {:.4}, u {:.3}–{:.3}",
+        errs.len(),
+        rms(&errs.iter().map(|e| e.0).collect::<Vec<_>>()),
+        errs.iter().map(|e| e.1).fold(1.0, f64::min),
+        errs.iter().map(|e| e.1).fold(0.0, f64::max)
+    );
+    println!("notes: {:?}", fit.notes);
+    if fit.law.parameters.outward.c == 0.0 {
+        assert!(
+            fit.notes.iter().any(|n| n.starts_with("side out") && n.contains("not vouched for")),
+            "{:?}",
+            fit.notes
+        );
+    }
 }
 
 /// The idealised two-sided demo draws every impact's e independently of its
@@ -203,4 +240,359 @@ fn one_sided_demo_rejects_only_through_its_first_impact() {
     let without = fit_law(rocklab::wall::Rocking::OneSided, &input).unwrap();
     println!("without impact 0: {:?}", without.sides);
     assert!(!without.rejects_constant, "{:?}", without.sides);
+}
+
+// ---------------------------------------------------------------------------------
+// The law's form judged on the engine's own per-impact truth (no reduction: cheap).
+// ---------------------------------------------------------------------------------
+
+/// One impact the truth lists: (test, k, side, a from the log, true r).
+type Listed = (String, usize, Side, f64, f64);
+
+/// (time, displacement) of a campaign CSV (`#` lines, then `time_s,disp_mm`).
+fn read_log(path: &Path) -> (Vec<f64>, Vec<f64>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let rows = text.lines().filter(|l| !l.starts_with('#')).skip(1);
+    rows.map(|l| {
+        let mut it = l.split(',').map(|x| x.trim().parse::<f64>().unwrap());
+        (it.next().unwrap(), it.next().unwrap())
+    })
+    .unzip()
+}
+
+/// Least-squares line (intercept, slope) through (t, x).
+fn line(t: &[f64], x: &[f64]) -> (f64, f64) {
+    let n = t.len() as f64;
+    let (mt, mx) = (t.iter().sum::<f64>() / n, x.iter().sum::<f64>() / n);
+    let sxy: f64 = t.iter().zip(x).map(|(a, b)| (a - mt) * (b - mx)).sum();
+    let sxx: f64 = t.iter().map(|a| (a - mt).powi(2)).sum();
+    let slope = sxy / sxx;
+    (mx - slope * mt, slope)
+}
+
+/// Every impact a MuJoCo campaign's truth lists, with its amplitude read from the
+/// log: the rest line (the logger's linear drift) is the line through the samples
+/// from 0.5 s after the last zero crossing to the end; a = asin(max |x| / L)/α over
+/// the half-cycle between the truth's crossings k − 1 (the release) and k.
+/// Listed: public campaigns, `e_engine` a number ≤ 1 (the engine saw a contact);
+/// hold-out campaigns (made by tools/mujoco_campaign.py, whose truth gives the
+/// velocity peaks, not `e_true`), r_k = |v_{k+1}/v_k|/e_H (the public truth's own
+/// definition of `e_true`) where the wall rocks through both half-cycles (one edge
+/// off the bedding for at least half of each, `lift_fraction_per_half_cycle`).
+fn truth_listed(name: &str) -> (rocklab::wall::Rocking, Vec<Listed>) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let truth: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let rocking = if truth["rocking"] == "two-sided" {
+        rocklab::wall::Rocking::TwoSided
+    } else {
+        rocklab::wall::Rocking::OneSided
+    };
+    let (alpha, e_h) = (truth["alpha_rad"].as_f64().unwrap(), truth["e_H"].as_f64().unwrap());
+    let mut out = Vec::new();
+    for t in truth["tests"].as_array().unwrap() {
+        let sim = &t["sim"];
+        let cross: Vec<f64> = match sim["impacts"].as_array() {
+            Some(imp) if !imp.is_empty() => imp.iter().map(|i| i["t_cross"].as_f64().unwrap()).collect(),
+            _ => sim["zero_crossings_s"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect(),
+        };
+        let lever_mm = 1e3
+            * sim["lever_arm_m"]
+                .as_f64()
+                .unwrap_or_else(|| truth["wall"]["sensor_height_m"].as_f64().unwrap());
+        let (time, x) = read_log(&dir.join(t["file"].as_str().unwrap()));
+        let rest: Vec<usize> = (0..time.len()).filter(|&i| time[i] > cross[cross.len() - 1] + 0.5).collect();
+        let (x0, slope) = line(
+            &rest.iter().map(|&i| time[i]).collect::<Vec<_>>(),
+            &rest.iter().map(|&i| x[i]).collect::<Vec<_>>(),
+        );
+        let release = sim["t_release_s"].as_f64().unwrap();
+        let listed: Vec<(usize, f64, bool)> = match t["e_true"].as_array() {
+            Some(e) => e
+                .iter()
+                .map(|e| {
+                    let real = e["e_engine"].as_f64().is_some_and(|x| x <= 1.0);
+                    (e["k"].as_u64().unwrap() as usize, e["e_over_eH"].as_f64().unwrap(), real)
+                })
+                .collect(),
+            None => {
+                let v: Vec<f64> = t["peaks"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|p| p["velocity_mm_s"].as_f64().unwrap())
+                    .collect();
+                let lift: Vec<f64> = sim["lift_fraction_per_half_cycle"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.as_f64().unwrap())
+                    .collect();
+                (0..v.len() - 1)
+                    .map(|k| (k, (v[k + 1] / v[k]).abs() / e_h, lift[k] >= 0.5 && lift[k + 1] >= 0.5))
+                    .collect()
+            }
+        };
+        for (k, r, real) in listed {
+            if !real || k >= cross.len() {
+                continue;
+            }
+            let t0 = if k == 0 { release } else { cross[k - 1] };
+            let apex = (0..time.len())
+                .filter(|&i| time[i] >= t0 && time[i] <= cross[k])
+                .map(|i| (x[i] - x0 - slope * time[i]).abs())
+                .fold(0.0, f64::max);
+            let a = (apex / lever_mm).min(1.0).asin() / alpha;
+            // Impact 0 enters the inward side; the sides alternate.
+            let side = if k % 2 == 0 { Side::Inward } else { Side::Outward };
+            out.push((t["id"].as_str().unwrap().to_string(), k, side, a, r));
+        }
+    }
+    (rocking, out)
+}
+
+/// g(a) = 1/√(a(2 − a)).
+fn g(a: f64) -> f64 {
+    rocklab::restitution_law::speed_shape(a)
+}
+
+/// The plausible u of a reading of r at amplitude a: u = 0.002 g(a). The estimator's
+/// own u on P2_140_1 (two-sided MuJoCo, 200 Hz) grows from 0.002 at a = 0.36 to 0.009
+/// at a = 0.065, about as g (1.3 → 3.9) does: a speed's error is roughly fixed, and
+/// the speed at impact is ∝ 1/g.
+fn plausible_u(a: f64) -> f64 {
+    0.002 * g(a)
+}
+
+/// Weighted least squares of r = b0 − b1 h(a) on `pts` (a, r), weights 1/u².
+fn wls(pts: &[(f64, f64)], h: &dyn Fn(f64) -> f64) -> (f64, f64) {
+    let (mut s, mut sx, mut sxx, mut sy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for &(a, r) in pts {
+        let (w, x) = (plausible_u(a).powi(-2), -h(a));
+        s += w;
+        sx += w * x;
+        sxx += w * x * x;
+        sy += w * r;
+        sxy += w * x * r;
+    }
+    let b1 = (s * sxy - sx * sy) / (s * sxx - sx * sx);
+    ((sy - b1 * sx) / s, b1)
+}
+
+/// As [`wls`] with h = g^q, q the weighted-χ² best on a grid 0.5, 0.55, …, 4.
+fn wls_free_exponent(pts: &[(f64, f64)]) -> (f64, f64, f64) {
+    let chi2 = |q: f64| {
+        let (b0, b1) = wls(pts, &|a| g(a).powf(q));
+        let c: f64 = pts.iter().map(|&(a, r)| ((b0 - b1 * g(a).powf(q) - r) / plausible_u(a)).powi(2)).sum();
+        (c, b0, b1)
+    };
+    (0..=70)
+        .map(|i| 0.5 + 0.05 * i as f64)
+        .map(|q| (chi2(q), q))
+        .min_by(|x, y| x.0 .0.total_cmp(&y.0 .0))
+        .map(|((_, b0, b1), q)| (b0, b1, q))
+        .unwrap()
+}
+
+/// The truth of one side (or of both, two-sided) as the law fits it: one ImpactTable
+/// per test with r = the truth's own, u = [`plausible_u`], uncorrelated.
+fn truth_tables(listed: &[Listed]) -> Vec<(String, rocklab::impacts::ImpactTable)> {
+    use rocklab::impacts::{ImpactCoefficient, ImpactTable};
+    let mut ids: Vec<&String> = listed.iter().map(|l| &l.0).collect();
+    ids.dedup();
+    ids.iter()
+        .map(|id| {
+            let impacts: Vec<ImpactCoefficient> = listed
+                .iter()
+                .filter(|l| &&l.0 == id)
+                .map(|l| ImpactCoefficient {
+                    k: l.1,
+                    side: l.2,
+                    amplitude_over_alpha: l.3,
+                    speed_before_mm_s: 1.0,
+                    speed_after_mm_s: l.4,
+                    e: l.4,
+                    e_u: Some(plausible_u(l.3)),
+                    r: l.4,
+                    r_u: Some(plausible_u(l.3)),
+                })
+                .collect();
+            let n = impacts.len();
+            let cov = (0..n)
+                .map(|i| (0..n).map(|j| if i == j { impacts[i].r_u.unwrap().powi(2) } else { 0.0 }).collect())
+                .collect();
+            (
+                id.to_string(),
+                ImpactTable {
+                    impacts,
+                    r_cov: Some(cov),
+                    raw: Vec::new(),
+                },
+            )
+        })
+        .collect()
+}
+
+/// RMS against the truth of the law fitted to the truth (rocklab's own fit, with its
+/// test against the constant) and of the best constant pair (each side's mean).
+fn law_on_truth(rocking: rocklab::wall::Rocking, listed: &[Listed]) -> (rocklab::law_fit::LawFit, f64, f64) {
+    use rocklab::law_fit::{fit_law, TestImpacts};
+    let tables = truth_tables(listed);
+    let input: Vec<TestImpacts> = tables.iter().map(|(id, table)| TestImpacts { id, table }).collect();
+    let fit = fit_law(rocking, &input).unwrap();
+    let err: Vec<f64> = listed.iter().map(|l| fit.law.r(l.2, l.3) - l.4).collect();
+    let two = rocking == rocklab::wall::Rocking::TwoSided;
+    let mean = |s: Side| {
+        let v: Vec<f64> = listed.iter().filter(|l| two || l.2 == s).map(|l| l.4).collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let cst: Vec<f64> = listed.iter().map(|l| mean(l.2) - l.4).collect();
+    (fit, rms(&err), rms(&cst))
+}
+
+/// The groups a law is fitted on: both sides two-sided, each side one-sided.
+fn groups(rocking: rocklab::wall::Rocking, listed: &[Listed]) -> Vec<(&'static str, Vec<(f64, f64)>)> {
+    let pick = |s: Option<Side>| listed.iter().filter(|l| s.is_none_or(|s| l.2 == s)).map(|l| (l.3, l.4)).collect();
+    match rocking {
+        rocklab::wall::Rocking::TwoSided => vec![("both", pick(None))],
+        rocklab::wall::Rocking::OneSided => vec![("in", pick(Some(Side::Inward))), ("out", pick(Some(Side::Outward)))],
+    }
+}
+
+/// Which form follows the engine's per-impact truth, on two walls of each rocking
+/// type (public and hold-out campaigns), down to the smallest listed amplitudes
+/// (docs/restitution-law.md, "The form"). Printed per campaign and side: the RMS of
+/// r = b0 − b1 h(a) for h = g (the speed-loss form), g² (a fixed energy loss), −ln a,
+/// and g^q with q free; and each fitted to the upper 60 % of the amplitudes and read
+/// below them (extrapolation). Asserted, on the falling groups (two-sided, one-sided
+/// outward): the free exponent's worst extrapolation is worse than the speed-loss
+/// form's (it runs to its bounds), which is why the law keeps q = 1; rocklab's own
+/// law fitted to the truth of the public campaigns is within the bounds and
+/// closer than the best constant pair where a law of amplitude alone can be
+/// (two-sided: 0.02 over every listed impact; one-sided outward: 0.025).
+#[test]
+fn law_form_against_the_engine_truth() {
+    let mut worst_q1: f64 = 0.0;
+    let mut worst_free: f64 = 0.0;
+    for name in [
+        "mujoco-public-two-sided",
+        "mujoco-holdout-two-sided",
+        "mujoco-public-one-sided",
+        "mujoco-holdout-one-sided",
+    ] {
+        let (rocking, listed) = truth_listed(name);
+        for (side, pts) in groups(rocking, &listed) {
+            let shapes: [(&str, &dyn Fn(f64) -> f64); 3] = [("g", &g), ("g²", &|a| g(a).powi(2)), ("−ln a", &|a: f64| -a.ln())];
+            let mut line = format!(
+                "{name} {side}: {} impacts, a = {:.4}–{:.3};",
+                pts.len(),
+                pts.iter().map(|p| p.0).fold(1.0, f64::min),
+                pts.iter().map(|p| p.0).fold(0.0, f64::max)
+            );
+            let mut sorted: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            sorted.sort_by(f64::total_cmp);
+            let cut = sorted[(0.4 * sorted.len() as f64) as usize];
+            let upper: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 >= cut).collect();
+            let lower: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.0 < cut).collect();
+            for (label, h) in shapes {
+                let (b0, b1) = wls(&pts, h);
+                let (u0, u1) = wls(&upper, h);
+                let fit = rms(&pts.iter().map(|&(a, r)| b0 - b1 * h(a) - r).collect::<Vec<_>>());
+                let ex = rms(&lower.iter().map(|&(a, r)| u0 - u1 * h(a) - r).collect::<Vec<_>>());
+                line += &format!(" {label}: {fit:.4} (extrapolated {ex:.3});");
+                if label == "g" && side != "in" {
+                    worst_q1 = worst_q1.max(ex);
+                }
+            }
+            let (b0, b1, q) = wls_free_exponent(&pts);
+            let (u0, u1, uq) = wls_free_exponent(&upper);
+            let fit = rms(&pts.iter().map(|&(a, r)| b0 - b1 * g(a).powf(q) - r).collect::<Vec<_>>());
+            let ex = rms(&lower.iter().map(|&(a, r)| u0 - u1 * g(a).powf(uq) - r).collect::<Vec<_>>());
+            line += &format!(" g^q: {fit:.4} at q = {q:.2} (extrapolated {ex:.3} at q = {uq:.2})");
+            if side != "in" {
+                worst_free = worst_free.max(ex);
+            }
+            // One law per test (the test's own bedding or transverse walls): what is
+            // left is the form's own misfit, the rest of the campaign's is the tests'
+            // differences, which no law of amplitude alone can follow.
+            let (mut own_g, mut own_q) = (Vec::new(), Vec::new());
+            let mut ids: Vec<&String> = listed.iter().map(|l| &l.0).collect();
+            ids.dedup();
+            for id in ids {
+                let mine: Vec<(f64, f64)> = listed
+                    .iter()
+                    .filter(|l| &l.0 == id && (side == "both" || (side == "in") == (l.2 == Side::Inward)))
+                    .map(|l| (l.3, l.4))
+                    .collect();
+                if mine.len() < 4 {
+                    continue;
+                }
+                let (b0, b1) = wls(&mine, &g);
+                own_g.extend(mine.iter().map(|&(a, r)| b0 - b1 * g(a) - r));
+                let (b0, b1, q) = wls_free_exponent(&mine);
+                own_q.extend(mine.iter().map(|&(a, r)| b0 - b1 * g(a).powf(q) - r));
+            }
+            if own_g.is_empty() {
+                line += "; one law per test: too few impacts per test";
+            } else {
+                line += &format!("; one law per test: g {:.4}, g^q {:.4}", rms(&own_g), rms(&own_q));
+            }
+            println!("{line}");
+        }
+        let (fit, law_rms, cst_rms) = law_on_truth(rocking, &listed);
+        let by_side = |s: Side| {
+            let e: Vec<f64> = listed.iter().filter(|l| l.2 == s).map(|l| fit.law.r(l.2, l.3) - l.4).collect();
+            rms(&e)
+        };
+        println!(
+            "{name}: rocklab's law fitted to the truth ({}, u = 0.002 g(a)): RMS {law_rms:.4} over {} listed impacts (in {:.4}, out {:.4}), best constant pair {cst_rms:.4}; {:?}",
+            fit.law.form.as_str(),
+            listed.len(),
+            by_side(Side::Inward),
+            by_side(Side::Outward),
+            fit.law.parameters
+        );
+        if name == "mujoco-public-two-sided" {
+            assert!(law_rms <= 0.02 && law_rms < cst_rms, "{law_rms:.4} vs constant {cst_rms:.4}");
+        }
+        if name == "mujoco-public-one-sided" {
+            truth_law_fixture(&fit);
+            let out: Vec<&Listed> = listed.iter().filter(|l| l.2 == Side::Outward).collect();
+            let mean = out.iter().map(|l| l.4).sum::<f64>() / out.len() as f64;
+            let cst_out = rms(&out.iter().map(|l| mean - l.4).collect::<Vec<_>>());
+            let law_out = by_side(Side::Outward);
+            assert!(law_out <= 0.025 && law_out < cst_out, "outward {law_out:.4} vs constant {cst_out:.4}");
+        }
+    }
+    println!("worst extrapolation on the falling groups: speed-loss {worst_q1:.3}, free exponent {worst_free:.3}");
+    assert!(worst_q1 < worst_free, "{worst_q1:.3} vs {worst_free:.3}");
+}
+
+/// `fixtures/laws/mujoco-public-one-sided-truth.json`, the law `rocklab demo` carries
+/// into the façade beside the campaign's own (docs/facade.md): rocklab's law fitted to
+/// the engine's per-impact truth of mujoco-public-one-sided (what the readings would
+/// give if they reached every listed impact), with its constant pair. Checked here
+/// against the fit to 1e-9; `ROCKLAB_WRITE_TRUTH_LAW=1` rewrites it.
+fn truth_law_fixture(fit: &rocklab::law_fit::LawFit) {
+    let c = &fit.constant.parameters;
+    let mut law = serde_json::to_value(fit.law).unwrap();
+    law["constant"] = serde_json::json!({
+        "r_in": c.inward.r_inf, "r_in_u": c.inward.cov[0][0].sqrt(),
+        "r_out": c.outward.r_inf, "r_out_u": c.outward.cov[0][0].sqrt(),
+    });
+    law["notes"] = serde_json::json!(fit.notes);
+    let doc = serde_json::json!({
+        "source": "rocklab's law (src/law_fit.rs) fitted to the per-impact truth (e_true, every listed impact) of fixtures/campaigns/mujoco-public-one-sided, u = 0.002 g(a); written by tests/law.rs law_form_against_the_engine_truth",
+        "restitution_law": law,
+    });
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/laws/mujoco-public-one-sided-truth.json");
+    if std::env::var("ROCKLAB_WRITE_TRUTH_LAW").is_ok() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, serde_json::to_string_pretty(&doc).unwrap() + "\n").unwrap();
+    }
+    let stored = rocklab::ingest::law::read(&path).unwrap();
+    let (a, b) = (stored.parameters, fit.law.parameters);
+    for (x, y) in [(a.inward, b.inward), (a.outward, b.outward)] {
+        assert!((x.r_inf - y.r_inf).abs() < 1e-9 && (x.c - y.c).abs() < 1e-9, "{x:?} vs {y:?}");
+    }
+    assert_eq!(stored.form, fit.law.form);
 }

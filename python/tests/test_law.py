@@ -23,3 +23,7 @@ def test_impacts_and_law_equal_cli(cli, tmp_path):
     assert len(law["curve"]) >= 20
     # The idealised two-sided demo draws e independently of the amplitude.
     assert law["rejects_constant"] is False and law["form"] == "constant"
+    # What the law vouches for: the constant, over the amplitudes it was fitted on.
+    (note,) = law["notes"]
+    assert note.startswith("side both: constant") and "not vouched for" in note
+    assert law["fits"][0]["amplitude_min"] <= law["fits"][0]["amplitude_max"]

@@ -16,7 +16,6 @@ use std::path::{Path, PathBuf};
 
 use polars::prelude::*;
 
-pub mod json;
 mod page;
 pub mod rows;
 
@@ -132,13 +131,10 @@ pub fn add_with_hook(archive: &Path, report_dirs: &[PathBuf], hook: &mut dyn FnM
     for dir in report_dirs {
         let file = dir.join("summary.json");
         let text = std::fs::read(&file).map_err(io(&file))?;
-        let doc = std::str::from_utf8(&text)
-            .map_err(|e| e.to_string())
-            .and_then(json::parse)
-            .map_err(|e| ArchiveError::Summary {
-                file: file.display().to_string(),
-                message: format!("not valid JSON: {e}"),
-            })?;
+        let doc: serde_json::Value = serde_json::from_slice(&text).map_err(|e| ArchiveError::Summary {
+            file: file.display().to_string(),
+            message: format!("not valid JSON: {e}"),
+        })?;
         let r = rows::reduction(&doc, &file.display().to_string())?;
         if !r.impacts_skipped.is_empty() {
             notes.push(format!(

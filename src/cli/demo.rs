@@ -34,8 +34,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     study.sets.push(set);
     ok &= reduce_for_law(&args, "mujoco-public-one-sided")?;
     for (campaign, name) in [("one-sided-demo", "campaign"), ("mujoco-public-one-sided", "mujoco")] {
-        study.sets.extend(law_sets(&args, &study, campaign, name)?);
+        study.sets.extend(law_sets(&study, &args.out.join(campaign).join("summary.json"), name)?);
     }
+    // The law the engine's own per-impact truth gives (what the readings would give
+    // if they reached every impact; tests/law.rs writes and checks it).
+    let truth_law = args.fixtures.join("laws").join("mujoco-public-one-sided-truth.json");
+    study.sets.extend(law_sets(&study, &truth_law, "mujoco truth")?);
     let scales = rocklab::facade::parse_scales(&args.scales)?;
     say(&format!(
         "façade study: {} ({} samples per record × polarity × set, seed {}; fragility from {} scales × {} samples)",
@@ -62,18 +66,18 @@ fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
     Ok(ok)
 }
 
-/// The law sets of `campaign` from the summary.json the demo wrote for it: "NAME
+/// The law sets of a summary.json (the one the demo wrote for a campaign, or a
+/// fixture of the same shape): "NAME
 /// law" (the fitted law) and "NAME constant" (the best constant pair of the same
 /// impacts, `restitution_law.constant`, as a constant law), both as r × e_H by
 /// Eq. 2 with the façade's α and drawn from their covariance, so that the two
 /// differ only in the law's form (the constant set is left out when the fitted
 /// law is itself the constant: the data did not reject it). None, said on the
 /// terminal, when the summary holds no law.
-fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, name: &str) -> anyhow::Result<Vec<rocklab::facade::CoefficientSet>> {
+fn law_sets(study: &rocklab::facade::Study, path: &std::path::Path, name: &str) -> anyhow::Result<Vec<rocklab::facade::CoefficientSet>> {
     use rocklab::facade::CoefficientSet;
     use rocklab::restitution_law::RestitutionLaw;
-    let path = args.out.join(campaign).join("summary.json");
-    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path)?)?;
+    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path)?)?;
     let Some(fitted) = doc.get("restitution_law") else {
         say(&format!(
             "{}: no restitution_law, so the façade study has no \"{name} law\" set",
@@ -82,7 +86,7 @@ fn law_sets(args: &DemoArgs, study: &rocklab::facade::Study, campaign: &str, nam
         return Ok(Vec::new());
     };
     let alpha = study.block.block.alpha;
-    let law = rocklab::ingest::law::read(&path)?;
+    let law = rocklab::ingest::law::read(path)?;
     let mut sets = vec![CoefficientSet::law(
         &format!("{name} law"),
         law,

@@ -153,6 +153,11 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         crate::law_fit::ALPHA_TEST,
         escape(&tests.join("; "))
     ));
+    s.push_str("<p>What the law vouches for:</p>\n<ul>\n");
+    for n in &fit.notes {
+        s.push_str(&format!("<li>{}</li>\n", escape(n)));
+    }
+    s.push_str("</ul>\n");
     if let Some(f) = figure {
         s.push_str(&format!(
             "<figure>{}<figcaption>r = e/e_H of every impact against the amplitude of the half-cycle it ends, by test; the law with its ±1 u band and the constant for comparison.</figcaption></figure>\n",

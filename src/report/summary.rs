@@ -80,6 +80,7 @@ enum LawDoc<'a> {
         rejects_constant: bool,
         speed_loss_fit: &'a RestitutionLaw,
         tests: &'a [String],
+        notes: &'a [String],
     },
     Missing {
         error: String,
@@ -121,6 +122,7 @@ fn law_doc(law: &Result<LawFit, crate::law_fit::LawFitError>) -> LawDoc<'_> {
                 rejects_constant: f.rejects_constant,
                 speed_loss_fit: &f.speed_loss,
                 tests: &f.tests_used,
+                notes: &f.notes,
             }
         }
         Err(e) => LawDoc::Missing { error: e.to_string() },

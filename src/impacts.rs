@@ -16,7 +16,8 @@
 //! (negative) correlation, and the fully correlated model-form terms of the peaks
 //! ([`crate::peaks`]) carry theirs. The law's fit ([`crate::law_fit`]) uses Σ_r.
 
-use crate::peaks::{Analysis, Impact};
+use crate::peaks::late::{LatePeak, Reading};
+use crate::peaks::{Analysis, Impact, ReadingMethod};
 use crate::wall::Side;
 
 /// One impact's coefficient (`tests[].impacts[]` in summary.json).
@@ -106,6 +107,107 @@ pub fn impact_table(a: &Analysis, geo: &Geometry, e_h: f64) -> ImpactTable {
     }
 }
 
+/// The largest standard uncertainty of a late impact's r that is reported: a
+/// coefficient known to no better than ±0.05 says nothing that the law could
+/// use, and the readings stop there.
+pub const MAX_LATE_R_U: f64 = 0.05;
+
+/// The impacts after the table's, from the late peaks ([`crate::peaks::late`]):
+/// `late[0]` must be the table's last peak, read again locally. Impact k is
+/// reported where peaks k and k + 1 were read the same way (both resolved
+/// contacts, or, on two-sided walls, both kinks: a ratio of two readings of
+/// one kind cancels the bias they share; mixed kinds moved r by 0.03–0.08 on
+/// the MuJoCo campaigns, and on one-sided walls the kink reading of the two
+/// sides' different contacts alternates by ±0.07–0.1 in r). The readings stop
+/// at the first impact with no such pair, with e > 1, or with u(r) above
+/// [`MAX_LATE_R_U`]. Each r's uncertainty is propagated from its two readings'
+/// (independent local fits); consecutive impacts that use the same reading of
+/// their shared peak carry its negative correlation.
+pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &Geometry, two_sided: bool) {
+    if late.first().map(|p| p.k) != Some(table.impacts.len()) {
+        return;
+    }
+    let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
+    for w in late.windows(2) {
+        let methods: &[ReadingMethod] = if two_sided {
+            &[ReadingMethod::LocalExtreme, ReadingMethod::LocalKink]
+        } else {
+            &[ReadingMethod::LocalExtreme]
+        };
+        let Some((a, b)) = methods.iter().find_map(|&m| Some((w[0].by(m)?, w[1].by(m)?))) else {
+            break;
+        };
+        let e = (b.velocity_mm_s / a.velocity_mm_s).abs();
+        let r = e / e_h;
+        let r_u = r * ((a.u_mm_s / a.velocity_mm_s).powi(2) + (b.u_mm_s / b.velocity_mm_s).powi(2)).sqrt();
+        if e > 1.0 || !r_u.is_finite() || r_u > MAX_LATE_R_U {
+            break;
+        }
+        let k = w[0].k;
+        let coefficient = ImpactCoefficient {
+            k,
+            side: if k % 2 == 0 { Side::Inward } else { Side::Outward },
+            amplitude_over_alpha: (w[0].apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / geo.alpha_rad,
+            speed_before_mm_s: a.velocity_mm_s.abs(),
+            speed_after_mm_s: b.velocity_mm_s.abs(),
+            e,
+            e_u: Some(r_u * e_h),
+            r,
+            r_u: Some(r_u),
+        };
+        added.push((coefficient, a, b));
+    }
+    append_late(table, &added, late);
+}
+
+/// Appends the late impacts, their covariance block and their raw impacts.
+fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], late: &[LatePeak]) {
+    if added.is_empty() {
+        return;
+    }
+    let n0 = table.impacts.len();
+    let n = n0 + added.len();
+    if let Some(cov) = table.r_cov.as_mut() {
+        for row in cov.iter_mut() {
+            row.resize(n, 0.0);
+        }
+        cov.resize(n, vec![0.0; n]);
+        for (i, (c, _, b)) in added.iter().enumerate() {
+            cov[n0 + i][n0 + i] = c.r_u.unwrap_or(0.0).powi(2);
+            // r_k and r_{k+1} share peak k + 1 where both use the same reading of it.
+            if let Some((d, a2, _)) = added.get(i + 1) {
+                if a2 == b {
+                    let v = b.velocity_mm_s.abs();
+                    let x = (c.r / v) * (-d.r / v) * b.u_mm_s * b.u_mm_s;
+                    cov[n0 + i][n0 + i + 1] = x;
+                    cov[n0 + i + 1][n0 + i] = x;
+                }
+            }
+        }
+    }
+    table.raw.truncate(n0);
+    for (i, (c, a, b)) in added.iter().enumerate() {
+        table.raw.push(Impact {
+            k: c.k,
+            time_s: late[i].crossing_s,
+            entering: c.side,
+            v_before_mm_s: a.velocity_mm_s,
+            v_after_mm_s: Some(b.velocity_mm_s),
+        });
+    }
+    if let Some(&(c, _, b)) = added.last() {
+        let next = c.k + 1;
+        table.raw.push(Impact {
+            k: next,
+            time_s: late[added.len()].crossing_s,
+            entering: if next % 2 == 0 { Side::Inward } else { Side::Outward },
+            v_before_mm_s: b.velocity_mm_s,
+            v_after_mm_s: None,
+        });
+    }
+    table.impacts.extend(added.iter().map(|a| a.0));
+}
+
 /// Σ_r = J Σ_v Jᵀ for r_k = |v_{k+1}/v_k| / e_H (module docs).
 pub fn ratio_covariance(v: &[f64], cov_v: &[Vec<f64>], e_h: f64) -> Vec<Vec<f64>> {
     let n = v.len().saturating_sub(1);
@@ -161,6 +263,61 @@ fn apex(a: &Analysis, geo: &Geometry, k: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn late(k: usize, v: f64, smooth: bool, kink: bool) -> LatePeak {
+        let reading = |x: f64| Reading {
+            time_s: k as f64,
+            velocity_mm_s: x,
+            u_mm_s: 0.01 * x.abs(),
+        };
+        LatePeak {
+            k,
+            crossing_s: k as f64 + 0.1,
+            apex_mm: 10.0,
+            smooth: smooth.then(|| reading(v)),
+            kink: kink.then(|| reading(1.01 * v)),
+        }
+    }
+
+    /// The pairing rules of [`extend_late`]: two readings of one kind per ratio,
+    /// resolved contacts first; kinks only on two-sided walls; the first mixed
+    /// pair ends the list; consecutive ratios sharing a reading are correlated.
+    #[test]
+    fn late_impacts_pair_readings_of_one_kind() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 1000.0,
+            alpha_rad: 0.1,
+        };
+        let peaks = [
+            late(0, -100.0, true, true),
+            late(1, 90.0, true, true),
+            late(2, -80.0, false, true),
+            late(3, 70.0, false, true),
+            late(4, -60.0, true, false),
+            late(5, 50.0, true, false),
+        ];
+        let mut two = ImpactTable {
+            r_cov: Some(Vec::new()),
+            ..ImpactTable::default()
+        };
+        extend_late(&mut two, &peaks, 1.0, &geo, true);
+        // 0: SS, 1: KK (peak 2 has no smooth reading), 2: KK, 3: mixed, stop.
+        let ks: Vec<usize> = two.impacts.iter().map(|i| i.k).collect();
+        assert_eq!(ks, [0, 1, 2]);
+        assert!((two.impacts[0].r - 0.9).abs() < 1e-12 && (two.impacts[1].r - 80.0 / 90.0).abs() < 1e-12);
+        let cov = two.r_cov.as_ref().unwrap();
+        assert_eq!(cov[0][1], 0.0, "impacts 0 and 1 use different readings of peak 1");
+        assert!(cov[1][2] < 0.0, "impacts 1 and 2 share the kink reading of peak 2");
+        assert_eq!(two.raw.len(), 4);
+        let mut one = ImpactTable::default();
+        extend_late(&mut one, &peaks, 1.0, &geo, false);
+        assert_eq!(one.impacts.len(), 1, "one-sided: resolved contacts only");
+        // A list that does not start at the table's last peak adds nothing.
+        let mut off = ImpactTable::default();
+        extend_late(&mut off, &peaks[1..], 1.0, &geo, true);
+        assert!(off.impacts.is_empty());
+    }
 
     /// Σ_r by hand for independent peaks: u(r_k)/r_k = √((u_k/v_k)² + (u_{k+1}/v_{k+1})²),
     /// and r_0, r_1 share v_1: cov = (r_0/v_1)(−r_1/v_1) u_1².

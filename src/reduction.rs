@@ -3,7 +3,7 @@
 //! and their uncertainties. The log arrives already read ([`crate::ingest`] reads
 //! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
 
-use crate::impacts::{impact_table, Geometry, ImpactTable};
+use crate::impacts::{extend_late, impact_table, Geometry, ImpactTable};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
 use crate::restitution::{coefficients, uncertainties, Coefficients};
 use crate::wall::{Rocking, Wall};
@@ -31,7 +31,7 @@ pub struct Reduced {
     pub uncertainty: Option<Coefficients>,
     /// Every impact the log resolves ([`resolve_impacts`]; empty until it runs).
     pub impacts: ImpactTable,
-    /// How many peaks the analysis behind `impacts` fitted (`impacts` has one fewer).
+    /// How many peaks `impacts` comes from, the late local readings included (`impacts` has one fewer).
     pub impact_peaks: usize,
 }
 
@@ -82,41 +82,32 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
     })
 }
 
-/// The most peaks any log is fitted with for its impacts (eleven impacts, as many as
+/// The most peaks any log is read for its impacts (eleven impacts, as many as
 /// the engine-made campaigns list).
 pub const MAX_IMPACT_PEAKS: usize = 12;
 
-/// Every impact the log resolves: the table's analysis (first `options.n_peaks`
-/// peaks) is refitted with 2, 4, … more peaks, up to [`MAX_IMPACT_PEAKS`], for as
-/// long as the log has the half-cycles and the refit keeps status ok (the
-/// plausibility checks of [`crate::peaks::checks`]); the last such fit gives the
-/// impacts ([`crate::impacts`]). A test whose longer fits all fail keeps the table's
-/// n − 1 impacts; a suspect test's impacts are those of its own analysis. Only the
-/// default estimator is refitted (the Savitzky–Golay one keeps its own peaks).
+/// Every impact the log resolves: the table's analysis gives the impacts
+/// between its peaks (n − 1 of them), and the later ones come from the peaks
+/// after it, each read from the samples around it
+/// ([`crate::peaks::late`], [`crate::impacts::extend_late`]), up to
+/// [`MAX_IMPACT_PEAKS`]. Only the default estimator's ok tests are extended (a
+/// suspect test keeps its own analysis' impacts; the Savitzky–Golay estimator
+/// its own peaks).
 pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_rad: f64, options: &PeakOptions) {
-    let geo = |a: &Analysis, t: &[f64]| {
-        impact_table(
-            a,
-            &Geometry {
-                time_s: t,
-                lever_arm_mm: phys.lever_arm_mm,
-                alpha_rad,
-            },
-            e_housner,
-        )
+    let geo = Geometry {
+        time_s: &red.log.time_s,
+        lever_arm_mm: phys.lever_arm_mm,
+        alpha_rad,
     };
-    let mut best = (geo(&red.analysis, &red.log.time_s), red.analysis.peaks.len());
-    let refit = options.method == crate::peaks::Method::Segments && red.analysis.quality.is_ok();
-    let mut n = options.n_peaks + 2;
-    while refit && n <= MAX_IMPACT_PEAKS {
-        let opts = PeakOptions { n_peaks: n, ..*options };
-        match analyse(&red.log.time_s, &red.log.disp_mm, phys, &opts) {
-            Ok(a) if a.quality.is_ok() && a.peaks.len() == n => best = (geo(&a, &red.log.time_s), n),
-            _ => break,
-        }
-        n += 2;
+    let mut table = impact_table(&red.analysis, &geo, e_housner);
+    let n = red.analysis.peaks.len();
+    if options.method == crate::peaks::Method::Segments && red.analysis.quality.is_ok() && n >= 2 {
+        let late = red.analysis.late_peaks(&red.log.time_s, phys.lever_arm_mm, n - 1, MAX_IMPACT_PEAKS);
+        let two_sided = phys.rocking == crate::wall::Rocking::TwoSided;
+        extend_late(&mut table, &late, e_housner, &geo, two_sided);
     }
-    (red.impacts, red.impact_peaks) = best;
+    red.impact_peaks = table.impacts.len() + 1;
+    red.impacts = table;
 }
 
 /// Contact phases are a property of the wall, not of one test: whether most of a

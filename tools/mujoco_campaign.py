@@ -44,6 +44,24 @@ PRESETS = {
                ("H2_80_1", 80, 100), ("H2_70_1", 70, 200)],
         seed=18_2,
     ),
+    # Generalisation checks of the per-impact readings (issue 20), never tuned on: a
+    # slender tall wall on a medium bedding, two-sided, and a squat short wall with
+    # soft, very lossy transverse walls, one-sided.
+    "fresh-two-sided": dict(
+        rocking="two-sided", H=3.40, b=0.30, w=1.40, density=1850.0, L=3.20,
+        bed_tc=(0.004, 0.012), bed_solimp=[0.08, 0.6, 0.0008, 0.5, 2.0],
+        tests=[("F2_180_1", 180, 200), ("F2_150_1", 150, 500), ("F2_120_1", 120, 1000),
+               ("F2_100_1", 100, 100), ("F2_160_1", 160, 200)],
+        seed=20_2,
+    ),
+    "fresh-one-sided": dict(
+        rocking="one-sided", H=1.90, b=0.32, w=1.20, density=2050.0, L=1.80,
+        bed_tc=(0.003, 0.010), bed_solimp=[0.06, 0.7, 0.0006, 0.5, 2.0],
+        K_in=(500.0, 1500.0), zeta_in=(0.05, 0.12),
+        tests=[("F1_190_1", 190, 200), ("F1_170_1", 170, 500), ("F1_160_1", 160, 1000),
+               ("F1_180_1", 180, 100), ("F1_150_1", 150, 200)],
+        seed=20_1,
+    ),
 }
 
 DT = 1e-4

@@ -235,14 +235,33 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
             continue;
         }
         let again = reduce_loaded(campaign, &t.spec, r.log.clone(), &expected);
-        if again
-            .result
-            .as_ref()
-            .is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok())
-        {
+        let fits = |o: &TestOutcome| o.result.as_ref().is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok());
+        if fits(&again) {
             t.result = again.result;
             t.warnings.push(format!(
                 "contact phases fitted because {with} of the campaign's {n_ok} tests with status ok show them; this log alone did not ask for them"
+            ));
+            continue;
+        }
+        // A compliant contact rounds an impact as a logger's low-pass does: where the
+        // wall's other tests show contacts and this one's filter was only estimated
+        // (never stated), the rounding is read as the wall's contacts.
+        if t.spec.acquisition != crate::peaks::acquisition::Acquisition::Unknown || r.analysis.response.source != "estimated" {
+            continue;
+        }
+        let unfiltered = PeakOptions {
+            acquisition: crate::peaks::acquisition::Acquisition::None,
+            ..expected
+        };
+        let spec = crate::ingest::manifest::TestSpec {
+            acquisition: crate::peaks::acquisition::Acquisition::None,
+            ..t.spec.clone()
+        };
+        let again = reduce_loaded(campaign, &spec, r.log.clone(), &unfiltered);
+        if fits(&again) {
+            t.result = again.result;
+            t.warnings.push(format!(
+                "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests with status ok show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
             ));
         }
     }

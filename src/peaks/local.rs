@@ -70,6 +70,10 @@ pub enum ReadingMethod {
     KinkModel,
     /// The local fit of the smooth extreme of a resolved contact ([`read`]).
     LocalExtreme,
+    /// A late peak (beyond the global fit's) read from the samples around
+    /// an impact sharper than them: the left-hand slope of a local kink fit
+    /// ([`super::late::read_kink`]).
+    LocalKink,
 }
 
 /// A local reading of one velocity peak.

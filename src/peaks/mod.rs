@@ -77,6 +77,7 @@
 pub mod acquisition;
 pub mod checks;
 mod crossings;
+pub mod late;
 pub mod local;
 pub mod model;
 mod picking;
@@ -274,6 +275,31 @@ impl Analysis {
                 })
             })
             .collect()
+    }
+}
+
+impl Analysis {
+    /// Peaks `from` … `max_peaks − 1` of the log `t` read locally, each from the
+    /// samples around it ([`late`]), as far as the log resolves them.
+    pub fn late_peaks(&self, t: &[f64], lever_mm: f64, from: usize, max_peaks: usize) -> Vec<late::LatePeak> {
+        if t.len() < 3 || t.len() != self.displacement_mm.len() {
+            return Vec::new();
+        }
+        let dt = median(&t.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+        let departure = t.partition_point(|&v| v < self.release_time_s).min(t.len() - 1);
+        let crossings = crossings::find_crossings(t, &self.displacement_mm, 0.0, self.noise_mm, departure, max_peaks);
+        late::read_late(
+            &late::LateInput {
+                t,
+                x: &self.displacement_mm,
+                lever_mm,
+                sigma: self.noise_mm,
+                dt,
+                release_s: self.release_time_s,
+                crossings: &crossings,
+            },
+            from,
+        )
     }
 }
 

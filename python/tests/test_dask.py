@@ -59,9 +59,10 @@ def test_simulate_many_on_dask_equals_sequential(client):
             calls.append(dict(block=str(BLOCK), record=pulse, scale=2.5, polarity=pol, e_in=e, e_out=0.7))
     seq = rocklab.dask.simulate_sequential(calls)
     on_dask = rocklab.dask.simulate_many(client, calls)
-    # The measured time sits in the summary's "timing" dict, which rows leave out.
-    assert "solve_wall_s" not in on_dask.columns
-    pd.testing.assert_frame_equal(on_dask, seq, check_exact=True)
+    # Each row keeps its run's measured time (from the summary's "timing"): the
+    # only column that may differ between two runs of the same call.
+    assert (on_dask["solve_wall_s"] > 0).all()
+    pd.testing.assert_frame_equal(on_dask.drop(columns=["solve_wall_s"]), seq.drop(columns=["solve_wall_s"]), check_exact=True)
     one = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, polarity=-1, e=0.8, history=False)
     row = on_dask[(on_dask["e_in"] == 0.8) & (on_dask["polarity"] == -1) & (on_dask["record"] == str(NRC_1030))].iloc[0]
     assert row["max_theta_over_alpha"] == one.summary["max_theta_over_alpha"]

@@ -271,9 +271,8 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
             )
         })
         .collect();
-    series.push(Series::line("law r(a)", BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
-    series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
-    series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
+    // The constant first, so that the law is drawn over it: where the data do not
+    // reject the constant the law is that constant and its line must still show.
     let span = law.first().zip(law.last()).map(|(a, b)| (lg(a.0), lg(b.0)));
     if let Some((x0, x1)) = span {
         series.push(Series::line(
@@ -282,6 +281,9 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
             vec![(x0, constant), (x1, constant)],
         ));
     }
+    series.push(Series::line("law r(a)", BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
+    series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
+    series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
     Panel::new(
         title,
         "log10 of the amplitude |θ|/α at the apex of the half-cycle the impact ends",

@@ -264,16 +264,7 @@ mod tests {
     fn a_kink_is_read_as_the_slope_before_it() {
         let dt = 0.002;
         let t: Vec<f64> = (0..200).map(|i| -0.2 + 0.0007 + i as f64 * dt).collect();
-        let y: Vec<f64> = t
-            .iter()
-            .map(|&s| {
-                if s < 0.0 {
-                    -(100.0 * s + 100.0 * s * s)
-                } else {
-                    -60.0 * s + 100.0 * s * s
-                }
-            })
-            .collect();
+        let y = crate::peaks::local::tests::kink_arcs(&t);
         let (v, u, time) = read_kink(&t, &y, 0.0, dt, 30, 0.001).expect("a kink");
         assert!((v + 100.0).abs() < 0.05 && (v + 100.0).abs() < 3.0 * u + 1e-3, "{v} ± {u}");
         assert!(time.abs() <= dt, "{time}");

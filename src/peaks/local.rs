@@ -372,7 +372,7 @@ pub(super) fn choose(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A smooth peak (a gravity arc that a compliant contact decelerates over
@@ -418,8 +418,14 @@ mod tests {
         assert!((r.velocity_mm_s - truth).abs() < 0.01 * truth.abs(), "{r:?} against {truth}");
         assert!((r.velocity_mm_s - truth).abs() < 3.0 * r.u_mm_s + 0.05, "{r:?} against {truth}");
         // A kink at τ = 0 (the same arcs, e = 0.6): −(100 + 200 τ), then −60 + 200 τ.
-        let yk: Vec<f64> = t
-            .iter()
+        let yk = kink_arcs(&t);
+        assert!(read(&t, &yk, 0.0, -1.0, dt, 30, 0.001).is_none());
+    }
+
+    /// The free arcs of an instantaneous impact at τ = 0 with e = 0.6 (gravity
+    /// changing sign at θ = 0): −(100 τ + 100 τ²), then −60 τ + 100 τ² (mm).
+    pub(crate) fn kink_arcs(t: &[f64]) -> Vec<f64> {
+        t.iter()
             .map(|&s| {
                 if s < 0.0 {
                     -(100.0 * s + 100.0 * s * s)
@@ -427,7 +433,6 @@ mod tests {
                     -60.0 * s + 100.0 * s * s
                 }
             })
-            .collect();
-        assert!(read(&t, &yk, 0.0, -1.0, dt, 30, 0.001).is_none());
+            .collect()
     }
 }

@@ -393,7 +393,7 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_campaign(campaign, PeakOptions::default());
         let start = Instant::now();
-        let cal = rocklab::calibrate::calibrate(&res.calibration_input(), impacts);
+        let cal = rocklab::calibrate::calibrate_with_law(&res.calibration_input(), impacts);
         let wall = start.elapsed().as_secs_f64();
         let (mut doc, _) = reduce_doc(&res, false)?;
         doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall)?;

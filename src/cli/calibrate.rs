@@ -8,7 +8,7 @@ use anyhow::Context;
 use clap::Args;
 
 use super::{load, say};
-use rocklab::calibrate::{calibrate, Calibration};
+use rocklab::calibrate::{calibrate_with_law, Calibration};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::PeakOptions;
 use rocklab::reduce::CampaignResult;
@@ -42,7 +42,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
 /// calibration on top, and print the calibration table.
 pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, n: usize) -> anyhow::Result<Calibration> {
     let start = std::time::Instant::now();
-    let cal = calibrate(&res.calibration_input(), n);
+    let cal = calibrate_with_law(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
     let files = calibration_files(res, &cal, n, wall, sources)?;
     write_files(out, &files).with_context(|| format!("writing {}", out.display()))?;
@@ -60,6 +60,14 @@ pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, 
             1.96 * j.se_e_out,
             j.rms_mm
         ));
+    }
+    if let Some(l) = &cal.law_replay {
+        for n in &l.notes {
+            say(&format!("law by replay, {n}"));
+        }
+        for (id, why) in &l.failed {
+            super::tell(&format!("test {id}: no law by replay: {why}"));
+        }
     }
     for (id, e) in &cal.failed {
         super::tell(&format!("test {id}: {e}"));

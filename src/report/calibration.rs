@@ -113,7 +113,7 @@ fn calibration_html(cal: &Calibration, n: usize, figs: &[Captioned]) -> String {
         cal.r_out,
         cal.e_housner
     );
-    s.push_str(&format!("<p>Restitution law: {}.</p>\n", escape(crate::calibrate::LAW_BY_REPLAY)));
+    s.push_str(&law_replay_html(cal));
     if let Some(j) = &cal.joint {
         s.push_str(&format!(
             "<p>One joint fit over the same tests: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",
@@ -249,4 +249,45 @@ pub fn coefficients_figure(cal: &Calibration) -> Result<Figure, ReportError> {
         x_names: cal.tests.iter().map(|t| t.id.clone()).collect(),
     };
     plots::render(&[panel], 900, 450)
+}
+
+/// The law by replay in report.html: how it was fitted, then its notes.
+fn law_replay_html(cal: &Calibration) -> String {
+    let Some(l) = &cal.law_replay else {
+        return "<p>Restitution law: not fitted by replay in this run.</p>\n".into();
+    };
+    let mut s = format!("<p>Restitution law {}.</p>\n<ul>\n", escape(crate::calibrate::LAW_BY_REPLAY));
+    for n in &l.notes {
+        s.push_str(&format!("<li>{}</li>\n", escape(n)));
+    }
+    for t in &l.tests {
+        let v: Vec<String> = t
+            .sides
+            .iter()
+            .map(|x| match &x.reason {
+                None => format!("{}: r_inf {:.4}, c {:.4} ± {:.4}", x.side, x.r_inf, x.c, x.cov[1][1].max(0.0).sqrt()),
+                Some(_) => format!(
+                    "{}: constant {:.4} (c {:.4} ± {:.4} not separated)",
+                    x.side,
+                    x.constant_r,
+                    x.c,
+                    x.cov[1][1].max(0.0).sqrt()
+                ),
+            })
+            .collect();
+        s.push_str(&format!(
+            "<li>test {}: {} impacts over a = {:.3}–{:.3}, RMS {:.3} mm (constant pair {:.3} mm); {}</li>\n",
+            escape(&t.id),
+            t.impacts,
+            t.amplitude_min,
+            t.amplitude_max,
+            t.law_rms_mm,
+            t.constant_rms_mm,
+            escape(&v.join("; "))
+        ));
+    }
+    for (id, why) in &l.failed {
+        s.push_str(&format!("<li>test {}: no law by replay: {}</li>\n", escape(id), escape(why)));
+    }
+    s + "</ul>\n"
 }

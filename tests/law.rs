@@ -81,6 +81,16 @@ fn per_impact(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
             continue;
         }
         if let Some(i) = r.impacts.impacts.iter().find(|i| i.k == *k) {
+            if std::env::var("READ_DEBUG").is_ok() {
+                println!(
+                    "read {id} k{k} {:?} a={:.4} r={:.3} true={r_true:.3} err={:+.4} u={:.4}",
+                    i.side,
+                    i.amplitude_over_alpha,
+                    i.r,
+                    i.r - r_true,
+                    i.r_u.unwrap()
+                );
+            }
             err.push(i.r - r_true);
             z.push((i.r - r_true).abs() / i.r_u.unwrap());
         }
@@ -121,15 +131,14 @@ fn law_vs_truth(law: &rocklab::restitution_law::RestitutionLaw, res: &CampaignRe
 }
 
 /// Two-sided compliant contacts. Asserted: every impact reported within RMS 0.015 of
-/// the truth (the issue's bound); the law closer to the truth than the best constant
-/// pair over every listed impact; the data reject the constant. Measured and
-/// printed, not met: RMS 0.02 of the law over the listed impacts. Since the late
-/// impacts are read locally (issue E) every listed impact is reported and the law
-/// is fitted to all of them: 0.0235 over all 40 (0.032 before, 0.016 inside the
-/// amplitudes 0.041–0.36 it was then fitted to; the small impacts fall faster than
-/// the form follows): docs/restitution-law.md.
-/// Ignored (minutes in a debug build): run with
-/// `cargo test --release --test law -- --ignored --nocapture`.
+/// the truth (the issue's bound); the law within RMS 0.02 of the truth over every
+/// listed impact (the issue's bound; measured 0.0149 since the fit adds the form's
+/// own misfit τ to every u, 0.0235 with the bare u) and closer than the best
+/// constant pair; the data reject the constant. Also printed: the same fit to the
+/// truth's own r with the readings' u (what the weighting alone gives):
+/// docs/restitution-law.md.
+/// Ignored (seconds in a debug build, beside the two reductions): run with
+/// `cargo test --test law -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn mujoco_two_sided_impacts_and_law() {
@@ -141,7 +150,33 @@ fn mujoco_two_sided_impacts_and_law() {
         100.0 * coverage
     );
     assert!(rms_r <= 0.015, "per-impact RMS {rms_r:.4}");
+    // The law with the readings' weights and covariance fitted to the truth's own r
+    // at the same impacts: the weighting's share of the law's misfit.
+    let listed = truth_impacts(&res, &truth);
+    let tables: Vec<(String, rocklab::impacts::ImpactTable)> = res
+        .tests
+        .iter()
+        .map(|t| {
+            let mut table = t.result.as_ref().unwrap().impacts.clone();
+            for i in table.impacts.iter_mut() {
+                if let Some(l) = listed.iter().find(|l| l.0 == t.spec.id && l.1 == i.k) {
+                    i.r = l.3;
+                }
+            }
+            (t.spec.id.clone(), table)
+        })
+        .collect();
+    let inputs: Vec<rocklab::law_fit::TestImpacts> = tables.iter().map(|(id, table)| rocklab::law_fit::TestImpacts { id, table }).collect();
+    let on_truth = rocklab::law_fit::fit_law(rocklab::wall::Rocking::TwoSided, &inputs).unwrap();
+    let (w_rms, _, _) = law_vs_truth(&on_truth.law, &res, &truth);
+    let p = on_truth.law.parameters.inward;
+    let q = res.law.as_ref().unwrap().law.parameters.inward;
+    println!(
+        "two-sided: the law with the readings' weights on the truth's r: r_inf {:.4} c {:.4}, RMS {w_rms:.4} against the truth; on the readings r_inf {:.4} c {:.4}",
+        p.r_inf, p.c, q.r_inf, q.c
+    );
     assert!(law_rms < cst_rms, "law {law_rms:.4} vs constant {cst_rms:.4}");
+    assert!(law_rms <= 0.02, "law RMS {law_rms:.4} against the truth");
     assert!(res.law.as_ref().unwrap().rejects_constant);
 }
 
@@ -207,21 +242,22 @@ fn two_sided_demo_keeps_a_constant() {
     assert_eq!(fit.law.form, rocklab::restitution_law::LawForm::Constant);
 }
 
-/// The idealised one-sided demo is not a constant: its generator gives the first
-/// (inward, largest-amplitude) impact of every test e/e_H = 0.32–0.37 and the later
-/// ones 0.45–0.95 at random (truth.json, `e_list_input`), the paper's r₁ effect. The
-/// fit sees that and rejects the constant inward; without impact 0 of each test it
-/// must not (the rest carries no trend with amplitude). The inward speed-loss fit has
-/// c < 0 (r rising as the amplitude falls, a speed gain), so the law keeps the
-/// constant pair.
+/// The idealised one-sided demo: its generator gives the first (inward,
+/// largest-amplitude) impact of every test e/e_H = 0.32–0.37 and the later ones
+/// 0.45–0.95 at random (truth.json, `e_list_input`), the paper's r₁ effect. The
+/// inward speed-loss fit has c < 0 (r rising as the amplitude falls, a speed gain),
+/// so the law keeps the constant pair, with or without impact 0. Since the fit adds
+/// the form's own misfit τ to every impact's u (Paule–Mandel, src/law_fit.rs), the
+/// precise first impacts no longer carry the test against the constant alone: it
+/// is not rejected (p = 0.033 > 0.005; it was p = 8e-4 with the bare u); without
+/// impact 0 it must not be either (the rest carries no trend with amplitude).
 #[test]
-fn one_sided_demo_rejects_only_through_its_first_impact() {
+fn one_sided_demo_keeps_a_constant_law() {
     use rocklab::impacts::ImpactTable;
     use rocklab::law_fit::{fit_law, TestImpacts};
     let (res, _) = reduce("one-sided-demo");
     let fit = res.law.as_ref().unwrap();
     println!("one-sided demo: {:?}", fit.sides);
-    assert!(fit.rejects_constant);
     assert!(fit.speed_loss.parameters.inward.c < 0.0);
     assert_eq!(fit.law.form, rocklab::restitution_law::LawForm::Constant);
     let trimmed: Vec<(String, ImpactTable)> = res
@@ -663,5 +699,46 @@ fn mujoco_law_by_replay() {
         if law.form == rocklab::restitution_law::LawForm::SpeedLoss {
             assert!(rms_replay < cst, "law by replay {rms_replay:.4} vs constant {cst:.4}");
         }
+    }
+}
+
+/// The law from the readings on the hold-out campaigns (another wall and bedding,
+/// made by tools/mujoco_campaign.py; not tuned on), against their truth's r at
+/// every listed impact (`truth_listed`: velocity-peak ratios while the wall lifts
+/// off), beside the best constant pair of those impacts. Printed, not asserted
+/// (docs/restitution-law.md). Ignored: two reductions.
+#[test]
+#[ignore]
+fn holdout_law_from_readings() {
+    for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
+        let (res, _) = reduce(name);
+        let (rocking, listed) = truth_listed(name);
+        let Ok(fit) = res.law.as_ref() else {
+            println!("{name}: no law: {:?}", res.law.as_ref().err());
+            continue;
+        };
+        let law = &fit.law;
+        let err: Vec<f64> = listed.iter().map(|l| law.r(l.2, l.3) - l.4).collect();
+        let mean = |s: Side| {
+            let v: Vec<f64> = listed
+                .iter()
+                .filter(|l| rocking == rocklab::wall::Rocking::TwoSided || l.2 == s)
+                .map(|l| l.4)
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        let cst: Vec<f64> = listed.iter().map(|l| mean(l.2) - l.4).collect();
+        println!(
+            "{name}: law from the readings ({:?}, {:?}) RMS {:.4} over {} listed impacts; best constant pair {:.4}; sides {:?}",
+            law.form,
+            law.parameters.inward,
+            rms(&err),
+            listed.len(),
+            rms(&cst),
+            fit.sides
+                .iter()
+                .map(|s| (s.0.clone(), s.1.impacts, s.1.p_value, s.1.form_u))
+                .collect::<Vec<_>>()
+        );
     }
 }

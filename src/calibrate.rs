@@ -427,10 +427,6 @@ pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_
     })
 }
 
-/// How the calibration fits the restitution law (issue 20; `law_by_replay` in
-/// summary.json, the details in `law_replay`).
-pub const LAW_BY_REPLAY: &str = "fitted by replay: each included test replayed with the solver under r(a) = r_inf - c g(a) per side over every half-cycle above 20 noise sigma (law_replay; a side whose speed loss the replay cannot separate from r_inf keeps its constant by replay over the same window, with the reason)";
-
 /// The campaign's calibration.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Calibration {
@@ -451,9 +447,6 @@ pub struct Calibration {
     pub per_impact: Vec<(String, Vec<f64>, Vec<f64>)>,
     pub included: Vec<String>,
     pub failed: Vec<(String, TestFailure)>,
-    /// The restitution law by replay ([`crate::law_replay`]; [`calibrate_with_law`]),
-    /// None where it was not fitted.
-    pub law_replay: Option<crate::law_replay::LawReplay>,
 }
 
 /// What calibrating one test gave.
@@ -530,16 +523,7 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
         per_impact: per,
         included,
         failed,
-        law_replay: None,
     }
-}
-
-/// [`calibrate`], then the restitution law by replay over the included tests
-/// ([`crate::law_replay`]).
-pub fn calibrate_with_law(c: &CampaignInput, n_impacts: usize) -> Calibration {
-    let mut cal = calibrate(c, n_impacts);
-    cal.law_replay = Some(crate::law_replay::fit_law_by_replay(c, &cal.tests, &cal.included, cal.e_housner));
-    cal
 }
 
 /// What an uncertainty ensemble needs from a calibration: the spread of the

@@ -46,6 +46,18 @@ use crate::reduction::Reduced;
 use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, SideLaw, AMPLITUDE_FLOOR};
 use crate::solver::impact::ImpactLaw;
 
+/// How the calibration fits the restitution law (issue 20; `law_by_replay` in
+/// summary.json, the details in `law_replay`).
+pub const LAW_BY_REPLAY: &str = "fitted by replay: each included test replayed with the solver under r(a) = r_inf - c g(a) per side over every half-cycle above 20 noise sigma (law_replay; a side whose speed loss the replay cannot separate from r_inf keeps its constant by replay over the same window, with the reason)";
+
+/// [`crate::calibrate::calibrate`], then the restitution law by replay over its
+/// included tests.
+pub fn calibrate_with_law(c: &CampaignInput, n_impacts: usize) -> (crate::calibrate::Calibration, LawReplay) {
+    let cal = crate::calibrate::calibrate(c, n_impacts);
+    let law = fit_law_by_replay(c, &cal.tests, &cal.included, cal.e_housner);
+    (cal, law)
+}
+
 /// Half-cycles less tall than this many σ of the noise end the window.
 pub const MIN_APEX_SIGMA: f64 = 20.0;
 /// The most impacts a law window holds.

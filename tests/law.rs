@@ -17,8 +17,17 @@ use rocklab::reduce::{reduce_campaign, CampaignResult};
 use rocklab::wall::Side;
 use serde_json::Value;
 
+/// A fixture campaign by name, or a campaign directory by path (one with a '/').
+fn campaign_dir(name: &str) -> std::path::PathBuf {
+    if name.contains('/') {
+        Path::new(name).to_path_buf()
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name)
+    }
+}
+
 fn reduce(name: &str) -> (CampaignResult, Value) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = campaign_dir(name);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let truth: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     (reduce_campaign(campaign, PeakOptions::default()), truth)
@@ -320,7 +329,7 @@ fn line(t: &[f64], x: &[f64]) -> (f64, f64) {
 /// definition of `e_true`) where the wall rocks through both half-cycles (one edge
 /// off the bedding for at least half of each, `lift_fraction_per_half_cycle`).
 fn truth_listed(name: &str) -> (rocklab::wall::Rocking, Vec<Listed>) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = campaign_dir(name);
     let truth: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let rocking = if truth["rocking"] == "two-sided" {
         rocklab::wall::Rocking::TwoSided
@@ -651,9 +660,9 @@ fn mujoco_law_by_replay() {
     for name in ["mujoco-public-two-sided", "mujoco-public-one-sided"] {
         let (res, truth) = reduce(name);
         let t0 = std::time::Instant::now();
-        let cal = rocklab::calibrate::calibrate_with_law(&res.calibration_input(), 6);
+        let (cal, law_replay) = rocklab::law_replay::calibrate_with_law(&res.calibration_input(), 6);
         let wall = t0.elapsed().as_secs_f64();
-        let lr = cal.law_replay.as_ref().unwrap();
+        let lr = &law_replay;
         for t in &lr.tests {
             println!(
                 "{name} {}: {} impacts, a = {:.4}–{:.3}, RMS {:.3} mm (constant {:.3} mm), {} it {:?}",
@@ -705,12 +714,18 @@ fn mujoco_law_by_replay() {
 /// The law from the readings on the hold-out campaigns (another wall and bedding,
 /// made by tools/mujoco_campaign.py; not tuned on), against their truth's r at
 /// every listed impact (`truth_listed`: velocity-peak ratios while the wall lifts
-/// off), beside the best constant pair of those impacts. Printed, not asserted
-/// (docs/restitution-law.md). Ignored: two reductions.
+/// off), beside the best constant pair of those impacts; likewise the campaign
+/// directories in `FRESH_CAMPAIGNS` (colon-separated; `python3
+/// tools/mujoco_campaign.py --preset fresh-two-sided --out DIR`). Printed, not
+/// asserted (docs/restitution-law.md). Ignored: two reductions or more.
 #[test]
 #[ignore]
 fn holdout_law_from_readings() {
-    for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
+    let fresh = std::env::var("FRESH_CAMPAIGNS").unwrap_or_default();
+    let names = ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"]
+        .into_iter()
+        .chain(fresh.split(':').filter(|s| !s.is_empty()));
+    for name in names {
         let (res, _) = reduce(name);
         let (rocking, listed) = truth_listed(name);
         let Ok(fit) = res.law.as_ref() else {

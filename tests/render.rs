@@ -159,7 +159,6 @@ fn calibration() -> Calibration {
         ],
         included: vec!["150_1".into(), "150_2".into()],
         failed: Vec::new(),
-        law_replay: None,
     }
 }
 

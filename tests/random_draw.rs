@@ -274,3 +274,19 @@ fn fir_tests_once_missed_are_reduced() {
     assert_eq!(off, 0);
     assert!(rate >= 0.99, "{rate}");
 }
+
+/// Compliant draws whose rounded contacts were taken for an unstated logger
+/// filter (status ok, 1.8–5.8 pp off) before the contact-phase model became the
+/// filter's rival (`peaks::acquisition::rival`): none is ok and more than 2 pp
+/// off now (each is flagged: the contacts fit its log as well as the filter).
+#[test]
+fn compliant_tests_once_taken_for_a_filter() {
+    let scored: Vec<Scored> = [1021, 1065, 1046, 1073]
+        .into_par_iter()
+        .map(|i| score(&draw(i, Family::Compliant)))
+        .collect();
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);
+    }
+}

@@ -199,9 +199,8 @@ pub fn replay_figure(f: &TestFit, w: &TestWindow, late_from: Option<f64>) -> Res
     plots::render(&panels, 1000, 320)
 }
 
-/// The y range of the coefficient plot: every interval and the mean, with a
-/// third of the span free above them for the legend.
-fn legend_room(cal: &Calibration) -> (f64, f64) {
+/// The y range of the coefficient plot: every interval and the mean.
+fn y_range(cal: &Calibration) -> (f64, f64) {
     let ends = cal
         .tests
         .iter()
@@ -214,38 +213,45 @@ fn legend_room(cal: &Calibration) -> (f64, f64) {
         return (0.0, 1.0);
     }
     let span = (hi - lo).max(0.05);
-    (lo - 0.08 * span, hi + 0.5 * span)
+    (lo - 0.08 * span, hi + 0.08 * span)
 }
 
 /// The fitted coefficients per test (named on the x axis) with their 95 %
-/// intervals (bars beside each point) and the mean e_in.
+/// intervals (a bar through each point; e_in left of the test's name, e_out
+/// right of it) and the mean e_in in e_in's colour.
 pub fn coefficients_figure(cal: &Calibration) -> Result<Figure, ReportError> {
     type Pick = fn(&TestFit) -> (f64, [f64; 2]);
     let mut series = Vec::new();
     let sides: [(&str, plots::RGBColor, Pick, f64); 2] = [
-        ("e_in", plots::RED, |t| (t.e_in, t.ci95_e_in), -0.05),
-        ("e_out", plots::BLUE, |t| (t.e_out, t.ci95_e_out), 0.05),
+        ("e_in", plots::RED, |t| (t.e_in, t.ci95_e_in), -0.08),
+        ("e_out", plots::BLUE, |t| (t.e_out, t.ci95_e_out), 0.08),
     ];
     for (label, color, pick, dx) in sides {
         let x = |i: usize| i as f64 + 1.0;
         series.push(Series::dots(
             label,
             color,
-            cal.tests.iter().enumerate().map(|(i, t)| (x(i), pick(t).0)).collect(),
+            cal.tests.iter().enumerate().map(|(i, t)| (x(i) + dx, pick(t).0)).collect(),
         ));
         for (i, t) in cal.tests.iter().enumerate() {
             let ci = pick(t).1;
             series.push(Series::line("", color, vec![(x(i) + dx, ci[0]), (x(i) + dx, ci[1])]));
         }
     }
+    let n = cal.tests.len() as f64;
+    series.push(Series::line(
+        &format!("mean e_in {:.3}", cal.e_in),
+        plots::RED,
+        vec![(0.5, cal.e_in), (n + 0.5, cal.e_in)],
+    ));
     let panel = Panel {
         title: format!("{}: fitted coefficients per test, 95 % intervals", cal.campaign),
         x_label: "test".into(),
         y_label: "coefficient of restitution".into(),
         series,
-        hline: Some((cal.e_in, format!("mean e_in {:.3}", cal.e_in))),
-        x_range: Some((0.5, cal.tests.len() as f64 + 0.5)),
-        y_range: Some(legend_room(cal)),
+        x_range: Some((0.5, n + 0.5)),
+        y_range: Some(y_range(cal)),
+        hline: None,
         x_names: cal.tests.iter().map(|t| t.id.clone()).collect(),
     };
     plots::render(&[panel], 900, 450)

@@ -14,7 +14,7 @@ type Result<T> = std::result::Result<T, ReportError>;
 /// The x axis of the IDA plots.
 const SCALE_AXIS: &str = "scale factor (× record, magnification included)";
 
-const COLORS: [plots::RGBColor; 4] = [plots::RED, plots::BLUE, plots::GREEN, plots::ORANGE];
+const COLORS: [plots::RGBColor; 9] = plots::SETS;
 
 /// What the study's core step computed.
 #[derive(Debug, Default)]

@@ -118,17 +118,116 @@ fn bounds(panel: &Panel) -> ((f64, f64), (f64, f64)) {
         let w = (b - a).abs().max(1e-9);
         (a - f * w, b + f * w)
     };
-    (pad(xs, 0.01), pad(ys, 0.08))
+    (pad(xs, 0.02), pad(ys, 0.08))
 }
 
-fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) -> Result<()>
+/// One legend entry: its label, colour, and whether the series is markers.
+struct Entry<'a> {
+    label: &'a str,
+    color: RGBColor,
+    marker: bool,
+}
+
+/// The legend of a panel: every labelled series, then the horizontal line.
+fn entries(panel: &Panel) -> Vec<Entry<'_>> {
+    let mut out: Vec<Entry> = panel
+        .series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .map(|s| Entry {
+            label: &s.label,
+            color: s.color,
+            marker: s.markers,
+        })
+        .collect();
+    if let Some((_, label)) = &panel.hline {
+        out.push(Entry {
+            label,
+            color: HLINE,
+            marker: false,
+        });
+    }
+    out
+}
+
+const LEGEND_FONT: u32 = 13;
+const LEGEND_ROW: i32 = 20;
+
+/// The width of the legend column: the widest label and its key, at most 40 %
+/// of the panel (longer labels are cut with "…").
+fn legend_width<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[Entry]) -> u32 {
+    if entries.is_empty() {
+        return 0;
+    }
+    let font = ("sans-serif", LEGEND_FONT).into_text_style(area);
+    let widest = entries
+        .iter()
+        .filter_map(|e| area.estimate_text_size(e.label, &font).ok())
+        .map(|(w, _)| w)
+        .max()
+        .unwrap_or(0);
+    (widest + 44).min(area.dim_in_pixel().0 * 2 / 5)
+}
+
+/// The legend drawn in its own column beside the plot, so that it never covers
+/// a point: a marker or a line segment in the series' colour, then the label.
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[Entry], top: i32) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let font = ("sans-serif", LEGEND_FONT).into_text_style(area);
+    let room = area.dim_in_pixel().0.saturating_sub(40);
+    for (i, e) in entries.iter().enumerate() {
+        let y = top + LEGEND_ROW * i as i32;
+        if e.marker {
+            area.draw(&Circle::new((16, y), 4, e.color.filled())).map_err(err)?;
+        } else {
+            area.draw(&PathElement::new(vec![(6, y), (26, y)], e.color.stroke_width(2)))
+                .map_err(err)?;
+        }
+        let label = fit_label(area, e.label, &font, room);
+        area.draw(&Text::new(label, (34, y - 7), font.clone())).map_err(err)?;
+    }
+    Ok(())
+}
+
+/// `label`, cut with "…" until it is at most `room` pixels wide.
+fn fit_label<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str, font: &TextStyle, room: u32) -> String {
+    let wide = |s: &str| area.estimate_text_size(s, font).map(|(w, _)| w > room).unwrap_or(false);
+    if !wide(label) {
+        return label.to_string();
+    }
+    let mut chars: Vec<char> = label.chars().collect();
+    while !chars.is_empty() && wide(&format!("{}…", chars.iter().collect::<String>())) {
+        chars.pop();
+    }
+    format!("{}…", chars.iter().collect::<String>())
+}
+
+/// The colour of a panel's horizontal line.
+const HLINE: RGBColor = BLUE;
+
+/// One panel: its title over the whole width, the chart, and its legend in a
+/// column `lw` pixels wide at the right (the same for every panel of a figure,
+/// so that stacked panels share their x axis).
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, lw: u32) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let area = area.titled(&panel.title, ("sans-serif", 18)).map_err(err)?;
+    let legend = entries(panel);
+    let (plot, side) = area.split_horizontally(area.dim_in_pixel().0 - lw);
+    draw_chart(&plot, panel)?;
+    draw_legend(&side, &legend, 14)
+}
+
+fn draw_chart<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
     let (x, y) = bounds(panel);
     let ((x0, x1), (y0, y1)) = (panel.x_range.unwrap_or(x), panel.y_range.unwrap_or(y));
     let mut chart = ChartBuilder::on(area)
-        .caption(&panel.title, ("sans-serif", 18))
         .margin(8)
         .x_label_area_size(36)
         .y_label_area_size(64)
@@ -149,40 +248,21 @@ where
         if s.markers {
             chart
                 .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-                .map_err(err)?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled()));
+                .map_err(err)?;
         } else {
             // Thick polylines of dense series render with gaps in the bitmap
             // backend: one pixel is enough there.
             let width = if s.points.len() > 1500 { 1 } else { 2 };
-            let drawn = chart
+            chart
                 .draw_series(LineSeries::new(s.points.iter().copied(), color.stroke_width(width)))
                 .map_err(err)?;
-            // A series without a label (an interval bar) stays out of the legend.
-            if !s.label.is_empty() {
-                drawn
-                    .label(s.label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
-            }
         }
     }
-    if let Some((h, label)) = &panel.hline {
-        let blue = RGBColor(31, 119, 180);
+    if let Some((h, _)) = &panel.hline {
         chart
-            .draw_series(LineSeries::new(vec![(x0, *h), (x1, *h)], blue.stroke_width(2)))
-            .map_err(err)?
-            .label(label.as_str())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2)));
+            .draw_series(LineSeries::new(vec![(x0, *h), (x1, *h)], HLINE.stroke_width(2)))
+            .map_err(err)?;
     }
-    chart
-        .configure_series_labels()
-        .label_font(("sans-serif", 13))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(err)?;
     Ok(())
 }
 
@@ -191,9 +271,10 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(err)?;
+    let lw = panels.iter().map(|p| legend_width(&root, &entries(p))).max().unwrap_or(0);
     let areas = root.split_evenly((panels.len(), 1));
     for (a, p) in areas.iter().zip(panels) {
-        draw_panel(a, p)?;
+        draw_panel(a, p, lw)?;
     }
     root.present().map_err(err)?;
     Ok(())
@@ -252,8 +333,19 @@ pub const BLUE: RGBColor = RGBColor(31, 119, 180);
 pub const ORANGE: RGBColor = RGBColor(255, 127, 14);
 pub const GREEN: RGBColor = RGBColor(44, 160, 44);
 
-/// Colours of the tests in a plot of many (cycled).
-pub const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, ORANGE, RGBColor(148, 103, 189), RGBColor(140, 86, 75)];
+pub const PURPLE: RGBColor = RGBColor(148, 103, 189);
+pub const BROWN: RGBColor = RGBColor(140, 86, 75);
+pub const PINK: RGBColor = RGBColor(227, 119, 194);
+pub const OLIVE: RGBColor = RGBColor(188, 189, 34);
+pub const CYAN: RGBColor = RGBColor(23, 190, 207);
+
+/// Colours of the tests in a plot of many (cycled; pink is kept for a plot's
+/// reference line).
+pub const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, ORANGE, PURPLE, BROWN];
+
+/// Nine distinct colours for sets that must not share one (a figure of up to
+/// nine coefficient sets).
+pub const SETS: [RGBColor; 9] = [RED, BLUE, GREEN, ORANGE, PURPLE, BROWN, PINK, OLIVE, CYAN];
 
 /// One panel of the restitution-law plot (issue 20): r of every impact against
 /// log₁₀ of its amplitude |θ|/α, one marker colour per test; the law with its ±1 u
@@ -277,7 +369,7 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
     if let Some((x0, x1)) = span {
         series.push(Series::line(
             &format!("constant r = {constant:.3}"),
-            ORANGE,
+            PINK,
             vec![(x0, constant), (x1, constant)],
         ));
     }

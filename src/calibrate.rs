@@ -15,6 +15,7 @@
 
 use crate::fit::{least_squares, FitError, FitResult, FitStop};
 use crate::reduction::Reduced;
+use crate::solver::impact::ImpactLaw;
 use crate::solver::{simulate_at, Ground, Restraint, RockingModel, Settings};
 use crate::wall::{Rocking, Side, Wall};
 
@@ -173,14 +174,19 @@ pub fn window(id: &str, r: &Reduced, lever_mm: f64, n_impacts: usize) -> Option<
     }
     let last = imp[n_impacts - 1].time_s;
     let gap = last - imp[n_impacts - 2].time_s;
-    let t_end = last + 0.5 * gap;
+    Some(window_to(id, r, lever_mm, last + 0.5 * gap))
+}
+
+/// The window of a reduced test from just before its release to `t_end`.
+pub fn window_to(id: &str, r: &Reduced, lever_mm: f64, t_end: f64) -> TestWindow {
+    let a = &r.analysis;
     let t0 = a.release_time_s - 0.1;
     let t = &r.log.time_s;
     let i0 = t.partition_point(|&v| v < t0);
     let i1 = t.partition_point(|&v| v <= t_end);
     let j = t.partition_point(|&v| v < a.release_time_s).min(t.len() - 1);
     let x_rel = crate::signal::median(&a.displacement_mm[j.saturating_sub(5)..=j]);
-    Some(TestWindow {
+    TestWindow {
         id: id.to_string(),
         t: t[i0..i1].to_vec(),
         x_mm: a.displacement_mm[i0..i1].to_vec(),
@@ -188,7 +194,7 @@ pub fn window(id: &str, r: &Reduced, lever_mm: f64, n_impacts: usize) -> Option<
         x_release_mm: x_rel,
         lever_mm,
         t_end,
-    })
+    }
 }
 
 /// Modelled readings of one test for coefficients (e_in, e_out) and nuisance
@@ -198,6 +204,13 @@ pub fn replay(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, nu: Nuisan
     if !(e_in > 0.0 && e_in < 1.5 && e_out > 0.0 && e_out < 1.5) {
         return None;
     }
+    replay_with(w, geom, e_in, e_out, None, nu)
+}
+
+/// As [`replay`] with a restitution law applied at every impact instead of
+/// (e_in, e_out) where `law` is given (the solver's [`ImpactLaw`]: e = min(1,
+/// r(side, a) e_H) with a the apex of the half-cycle that ends).
+pub fn replay_with(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, law: Option<ImpactLaw>, nu: Nuisance) -> Option<Vec<f64>> {
     let z = nu.zero_offset_mm();
     let s = (w.x_release_mm - z) / w.lever_mm;
     if s.is_nan() || s.abs() >= 1.0 {
@@ -215,7 +228,7 @@ pub fn replay(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, nu: Nuisan
         ties: Vec::new(),
         e_in,
         e_out,
-        law: None,
+        law,
         overturn_limit: std::f64::consts::FRAC_PI_2,
         linearized: false,
     };
@@ -413,13 +426,6 @@ pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_
         tests: ws.iter().map(|w| w.id.clone()).collect(),
     })
 }
-
-/// What the calibration says of the restitution law (issue 20): the replay cannot
-/// fit it. The replay applies one pair (e_in, e_out) at every impact of a test, and
-/// its window holds the first few impacts, which span too little amplitude to tell
-/// r∞ from c; the law is fitted from every impact the reduction resolves instead
-/// ([`crate::law_fit`]).
-pub const LAW_BY_REPLAY: &str = "not fitted by replay: the replay applies one constant pair (e_in, e_out) at every impact of a test, and its window of the first impacts spans too little amplitude to tell the law's r_inf from c; the law is fitted from every impact the reduction resolves (summary.json restitution_law)";
 
 /// The campaign's calibration.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -42,6 +42,7 @@ pub mod ground_motion;
 pub mod impacts;
 pub mod ingest;
 pub mod law_fit;
+pub mod law_replay;
 pub mod limits;
 pub mod outcomes;
 pub mod peaks;

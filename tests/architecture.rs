@@ -19,6 +19,7 @@ const CORE: &[&str] = &[
     "src/fragility.rs",
     "src/impacts.rs",
     "src/law_fit.rs",
+    "src/law_replay.rs",
     "src/limits.rs",
     "src/outcomes.rs",
     "src/ground_motion",

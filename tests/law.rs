@@ -17,8 +17,17 @@ use rocklab::reduce::{reduce_campaign, CampaignResult};
 use rocklab::wall::Side;
 use serde_json::Value;
 
+/// A fixture campaign by name, or a campaign directory by path (one with a '/').
+fn campaign_dir(name: &str) -> std::path::PathBuf {
+    if name.contains('/') {
+        Path::new(name).to_path_buf()
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name)
+    }
+}
+
 fn reduce(name: &str) -> (CampaignResult, Value) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = campaign_dir(name);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let truth: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     (reduce_campaign(campaign, PeakOptions::default()), truth)
@@ -81,6 +90,16 @@ fn per_impact(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
             continue;
         }
         if let Some(i) = r.impacts.impacts.iter().find(|i| i.k == *k) {
+            if std::env::var("READ_DEBUG").is_ok() {
+                println!(
+                    "read {id} k{k} {:?} a={:.4} r={:.3} true={r_true:.3} err={:+.4} u={:.4}",
+                    i.side,
+                    i.amplitude_over_alpha,
+                    i.r,
+                    i.r - r_true,
+                    i.r_u.unwrap()
+                );
+            }
             err.push(i.r - r_true);
             z.push((i.r - r_true).abs() / i.r_u.unwrap());
         }
@@ -93,7 +112,11 @@ fn per_impact(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
 /// The law read at every listed impact's amplitude against the truth, and the best
 /// constant pair (each side's mean true r: the least-squares constant) likewise.
 fn law_against_truth(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
-    let law = &res.law.as_ref().unwrap().law;
+    law_vs_truth(&res.law.as_ref().unwrap().law, res, truth)
+}
+
+/// As [`law_against_truth`] for any law.
+fn law_vs_truth(law: &rocklab::restitution_law::RestitutionLaw, res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
     let listed = truth_impacts(res, truth);
     let err: Vec<f64> = listed.iter().map(|(_, _, side, r, a)| law.r(*side, *a) - r).collect();
     if std::env::var("LAW_DEBUG").is_ok() {
@@ -117,15 +140,14 @@ fn law_against_truth(res: &CampaignResult, truth: &Value) -> (f64, f64, f64) {
 }
 
 /// Two-sided compliant contacts. Asserted: every impact reported within RMS 0.015 of
-/// the truth (the issue's bound); the law closer to the truth than the best constant
-/// pair over every listed impact; the data reject the constant. Measured and
-/// printed, not met: RMS 0.02 of the law over the listed impacts. Since the late
-/// impacts are read locally (issue E) every listed impact is reported and the law
-/// is fitted to all of them: 0.0235 over all 40 (0.032 before, 0.016 inside the
-/// amplitudes 0.041–0.36 it was then fitted to; the small impacts fall faster than
-/// the form follows): docs/restitution-law.md.
-/// Ignored (minutes in a debug build): run with
-/// `cargo test --release --test law -- --ignored --nocapture`.
+/// the truth (the issue's bound); the law within RMS 0.02 of the truth over every
+/// listed impact (the issue's bound; measured 0.0149 since the fit adds the form's
+/// own misfit τ to every u, 0.0235 with the bare u) and closer than the best
+/// constant pair; the data reject the constant. Also printed: the same fit to the
+/// truth's own r with the readings' u (what the weighting alone gives):
+/// docs/restitution-law.md.
+/// Ignored (seconds in a debug build, beside the two reductions): run with
+/// `cargo test --test law -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn mujoco_two_sided_impacts_and_law() {
@@ -137,7 +159,33 @@ fn mujoco_two_sided_impacts_and_law() {
         100.0 * coverage
     );
     assert!(rms_r <= 0.015, "per-impact RMS {rms_r:.4}");
+    // The law with the readings' weights and covariance fitted to the truth's own r
+    // at the same impacts: the weighting's share of the law's misfit.
+    let listed = truth_impacts(&res, &truth);
+    let tables: Vec<(String, rocklab::impacts::ImpactTable)> = res
+        .tests
+        .iter()
+        .map(|t| {
+            let mut table = t.result.as_ref().unwrap().impacts.clone();
+            for i in table.impacts.iter_mut() {
+                if let Some(l) = listed.iter().find(|l| l.0 == t.spec.id && l.1 == i.k) {
+                    i.r = l.3;
+                }
+            }
+            (t.spec.id.clone(), table)
+        })
+        .collect();
+    let inputs: Vec<rocklab::law_fit::TestImpacts> = tables.iter().map(|(id, table)| rocklab::law_fit::TestImpacts { id, table }).collect();
+    let on_truth = rocklab::law_fit::fit_law(rocklab::wall::Rocking::TwoSided, &inputs).unwrap();
+    let (w_rms, _, _) = law_vs_truth(&on_truth.law, &res, &truth);
+    let p = on_truth.law.parameters.inward;
+    let q = res.law.as_ref().unwrap().law.parameters.inward;
+    println!(
+        "two-sided: the law with the readings' weights on the truth's r: r_inf {:.4} c {:.4}, RMS {w_rms:.4} against the truth; on the readings r_inf {:.4} c {:.4}",
+        p.r_inf, p.c, q.r_inf, q.c
+    );
     assert!(law_rms < cst_rms, "law {law_rms:.4} vs constant {cst_rms:.4}");
+    assert!(law_rms <= 0.02, "law RMS {law_rms:.4} against the truth");
     assert!(res.law.as_ref().unwrap().rejects_constant);
 }
 
@@ -203,21 +251,22 @@ fn two_sided_demo_keeps_a_constant() {
     assert_eq!(fit.law.form, rocklab::restitution_law::LawForm::Constant);
 }
 
-/// The idealised one-sided demo is not a constant: its generator gives the first
-/// (inward, largest-amplitude) impact of every test e/e_H = 0.32–0.37 and the later
-/// ones 0.45–0.95 at random (truth.json, `e_list_input`), the paper's r₁ effect. The
-/// fit sees that and rejects the constant inward; without impact 0 of each test it
-/// must not (the rest carries no trend with amplitude). The inward speed-loss fit has
-/// c < 0 (r rising as the amplitude falls, a speed gain), so the law keeps the
-/// constant pair.
+/// The idealised one-sided demo: its generator gives the first (inward,
+/// largest-amplitude) impact of every test e/e_H = 0.32–0.37 and the later ones
+/// 0.45–0.95 at random (truth.json, `e_list_input`), the paper's r₁ effect. The
+/// inward speed-loss fit has c < 0 (r rising as the amplitude falls, a speed gain),
+/// so the law keeps the constant pair, with or without impact 0. Since the fit adds
+/// the form's own misfit τ to every impact's u (Paule–Mandel, src/law_fit.rs), the
+/// precise first impacts no longer carry the test against the constant alone: it
+/// is not rejected (p = 0.033 > 0.005; it was p = 8e-4 with the bare u); without
+/// impact 0 it must not be either (the rest carries no trend with amplitude).
 #[test]
-fn one_sided_demo_rejects_only_through_its_first_impact() {
+fn one_sided_demo_keeps_a_constant_law() {
     use rocklab::impacts::ImpactTable;
     use rocklab::law_fit::{fit_law, TestImpacts};
     let (res, _) = reduce("one-sided-demo");
     let fit = res.law.as_ref().unwrap();
     println!("one-sided demo: {:?}", fit.sides);
-    assert!(fit.rejects_constant);
     assert!(fit.speed_loss.parameters.inward.c < 0.0);
     assert_eq!(fit.law.form, rocklab::restitution_law::LawForm::Constant);
     let trimmed: Vec<(String, ImpactTable)> = res
@@ -280,7 +329,7 @@ fn line(t: &[f64], x: &[f64]) -> (f64, f64) {
 /// definition of `e_true`) where the wall rocks through both half-cycles (one edge
 /// off the bedding for at least half of each, `lift_fraction_per_half_cycle`).
 fn truth_listed(name: &str) -> (rocklab::wall::Rocking, Vec<Listed>) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = campaign_dir(name);
     let truth: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let rocking = if truth["rocking"] == "two-sided" {
         rocklab::wall::Rocking::TwoSided
@@ -595,4 +644,116 @@ fn truth_law_fixture(fit: &rocklab::law_fit::LawFit) {
         assert!((x.r_inf - y.r_inf).abs() < 1e-9 && (x.c - y.c).abs() < 1e-9, "{x:?} vs {y:?}");
     }
     assert_eq!(stored.form, fit.law.form);
+}
+
+/// Issue 20: `calibrate` fits the law by replay as well. On the two MuJoCo
+/// campaigns: each test replayed under r(a) = r∞ − c g(a) over every half-cycle
+/// above 20 σ; printed per test and for the campaign, against the engine's
+/// per-impact truth (RMS over every listed impact) beside the law from the
+/// per-impact readings and the best constant pair (docs/calibration.md).
+/// Asserted: every included test has a law replay, and where the campaign's law
+/// by replay keeps the speed-loss form it is closer to the truth than the best
+/// constant pair. Ignored: minutes in a debug build.
+#[test]
+#[ignore]
+fn mujoco_law_by_replay() {
+    for name in ["mujoco-public-two-sided", "mujoco-public-one-sided"] {
+        let (res, truth) = reduce(name);
+        let t0 = std::time::Instant::now();
+        let (cal, law_replay) = rocklab::law_replay::calibrate_with_law(&res.calibration_input(), 6);
+        let wall = t0.elapsed().as_secs_f64();
+        let lr = &law_replay;
+        for t in &lr.tests {
+            println!(
+                "{name} {}: {} impacts, a = {:.4}–{:.3}, RMS {:.3} mm (constant {:.3} mm), {} it {:?}",
+                t.id, t.impacts, t.amplitude_min, t.amplitude_max, t.law_rms_mm, t.constant_rms_mm, t.iterations, t.stop
+            );
+            for s in &t.sides {
+                println!(
+                    "    {}: r_inf {:.4} ± {:.4}, c {:.4} ± {:.4} (rho {:.3}, z {:.1}); constant {:.4}; {}",
+                    s.side,
+                    s.r_inf,
+                    s.cov[0][0].sqrt(),
+                    s.c,
+                    s.cov[1][1].sqrt(),
+                    s.correlation,
+                    s.z,
+                    s.constant_r,
+                    s.reason.as_deref().unwrap_or("law")
+                );
+            }
+        }
+        assert!(lr.failed.is_empty(), "{:?}", lr.failed);
+        assert_eq!(lr.tests.len(), cal.included.len());
+        let law = lr.law.as_ref().unwrap();
+        let (rms_replay, cst, inside) = law_vs_truth(law, &res, &truth);
+        let (rms_readings, _, _) = law_against_truth(&res, &truth);
+        // Each test's own law by replay against that test's listed impacts.
+        let listed = truth_impacts(&res, &truth);
+        let mut per_test = Vec::new();
+        for t in &lr.tests {
+            let one = |s: &rocklab::law_replay::SideReplay| (s.r_inf, s.c);
+            let (i, o) = (one(&t.sides[0]), one(t.sides.last().unwrap()));
+            for l in listed.iter().filter(|l| l.0 == t.id) {
+                let (r_inf, c) = if l.2 == Side::Inward { i } else { o };
+                per_test.push(r_inf - c * rocklab::restitution_law::speed_shape(l.4) - l.3);
+            }
+        }
+        println!("{name}: notes {:?}", lr.notes);
+        println!("{name}: against the readings {:?}", lr.against_readings);
+        println!(
+            "{name}: law by replay RMS {rms_replay:.4} over all listed impacts ({inside:.4} inside its amplitudes); each test's own law by replay {:.4}; law from the readings {rms_readings:.4}; best constant pair {cst:.4}; calibrate with the law {wall:.1} s",
+            rms(&per_test)
+        );
+        if law.form == rocklab::restitution_law::LawForm::SpeedLoss {
+            assert!(rms_replay < cst, "law by replay {rms_replay:.4} vs constant {cst:.4}");
+        }
+    }
+}
+
+/// The law from the readings on the hold-out campaigns (another wall and bedding,
+/// made by tools/mujoco_campaign.py; not tuned on), against their truth's r at
+/// every listed impact (`truth_listed`: velocity-peak ratios while the wall lifts
+/// off), beside the best constant pair of those impacts; likewise the campaign
+/// directories in `FRESH_CAMPAIGNS` (colon-separated; `python3
+/// tools/mujoco_campaign.py --preset fresh-two-sided --out DIR`). Printed, not
+/// asserted (docs/restitution-law.md). Ignored: two reductions or more.
+#[test]
+#[ignore]
+fn holdout_law_from_readings() {
+    let fresh = std::env::var("FRESH_CAMPAIGNS").unwrap_or_default();
+    let names = ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"]
+        .into_iter()
+        .chain(fresh.split(':').filter(|s| !s.is_empty()));
+    for name in names {
+        let (res, _) = reduce(name);
+        let (rocking, listed) = truth_listed(name);
+        let Ok(fit) = res.law.as_ref() else {
+            println!("{name}: no law: {:?}", res.law.as_ref().err());
+            continue;
+        };
+        let law = &fit.law;
+        let err: Vec<f64> = listed.iter().map(|l| law.r(l.2, l.3) - l.4).collect();
+        let mean = |s: Side| {
+            let v: Vec<f64> = listed
+                .iter()
+                .filter(|l| rocking == rocklab::wall::Rocking::TwoSided || l.2 == s)
+                .map(|l| l.4)
+                .collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        let cst: Vec<f64> = listed.iter().map(|l| mean(l.2) - l.4).collect();
+        println!(
+            "{name}: law from the readings ({:?}, {:?}) RMS {:.4} over {} listed impacts; best constant pair {:.4}; sides {:?}",
+            law.form,
+            law.parameters.inward,
+            rms(&err),
+            listed.len(),
+            rms(&cst),
+            fit.sides
+                .iter()
+                .map(|s| (s.0.clone(), s.1.impacts, s.1.p_value, s.1.form_u))
+                .collect::<Vec<_>>()
+        );
+    }
 }

@@ -393,10 +393,10 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_campaign(campaign, PeakOptions::default());
         let start = Instant::now();
-        let cal = rocklab::calibrate::calibrate(&res.calibration_input(), impacts);
+        let (cal, law) = rocklab::law_replay::calibrate_with_law(&res.calibration_input(), impacts);
         let wall = start.elapsed().as_secs_f64();
         let (mut doc, _) = reduce_doc(&res, false)?;
-        doc["summary"]["calibration"] = docs::calibration_summary(&cal, wall)?;
+        doc["summary"]["calibration"] = docs::calibration_summary(&cal, Some(&law), wall)?;
         docs::gather_timing(&mut doc["summary"]);
         doc["calibration_toml"] = json!(rocklab::calibrate::to_toml(&cal)?);
         Ok(doc)

@@ -29,6 +29,10 @@ def test_calibrate_equals_cli(cli, tmp_path):
     assert res.calibration_toml == (tmp_path / "calibration.toml").read_text()
     assert list(res.fits["id"]) == [t["id"] for t in expected["calibration"]["tests"]]
     assert 0 < res.calibration["e_in"] < 1 and 0 < res.calibration["e_out"] < 1
+    # Issue 20: the law by replay, per included test and for the campaign.
+    law = res.summary["calibration"]["law_replay"]
+    assert sorted([t["id"] for t in law["tests"]] + [f[0] for f in law["failed"]]) == sorted(expected["calibration"]["included"])
+    assert law["notes"] and law["law"]["form"] in ("constant", "speed-loss")
 
 
 def test_facade_equals_cli_summary_and_ida(cli, tmp_path):

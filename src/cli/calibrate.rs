@@ -8,8 +8,9 @@ use anyhow::Context;
 use clap::Args;
 
 use super::{load, say};
-use rocklab::calibrate::{calibrate, Calibration};
+use rocklab::calibrate::Calibration;
 use rocklab::ingest::Campaign;
+use rocklab::law_replay::calibrate_with_law;
 use rocklab::peaks::PeakOptions;
 use rocklab::reduce::CampaignResult;
 use rocklab::report::calibration::{calibration_files, calibration_table};
@@ -42,9 +43,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
 /// calibration on top, and print the calibration table.
 pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, n: usize) -> anyhow::Result<Calibration> {
     let start = std::time::Instant::now();
-    let cal = calibrate(&res.calibration_input(), n);
+    let (cal, law) = calibrate_with_law(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
-    let files = calibration_files(res, &cal, n, wall, sources)?;
+    let files = calibration_files(res, &cal, Some(&law), n, wall, sources)?;
     write_files(out, &files).with_context(|| format!("writing {}", out.display()))?;
     say(&format!(
         "calibration of {} ({} rocking), {} impacts per test, {:.2} s:",
@@ -60,6 +61,12 @@ pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, 
             1.96 * j.se_e_out,
             j.rms_mm
         ));
+    }
+    for n in &law.notes {
+        say(&format!("law by replay, {n}"));
+    }
+    for (id, why) in &law.failed {
+        super::tell(&format!("test {id}: no law by replay: {why}"));
     }
     for (id, e) in &cal.failed {
         super::tell(&format!("test {id}: {e}"));

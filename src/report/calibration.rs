@@ -9,18 +9,26 @@ use super::plots::{self, Captioned, Figure, Panel, Series};
 use super::table::{to_html, Align, Cell, Column, Table};
 use super::{Files, ReportError};
 use crate::calibrate::{Calibration, TestFit, TestWindow};
+use crate::law_replay::LawReplay;
 use crate::reduce::CampaignResult;
 
 /// Everything `calibrate` writes: calibration.toml, the reduce outputs with the
 /// calibration in summary.json and report.html, and its plots. `n` is the number
 /// of impacts in the fitted window; `wall_s` how long the calibration took.
-pub fn calibration_files(res: &CampaignResult, cal: &Calibration, n: usize, wall_s: f64, sources: &Sources) -> Result<Files, ReportError> {
+pub fn calibration_files(
+    res: &CampaignResult,
+    cal: &Calibration,
+    law: Option<&LawReplay>,
+    n: usize,
+    wall_s: f64,
+    sources: &Sources,
+) -> Result<Files, ReportError> {
     let figs = figures(res, cal, n)?;
     let extra = Extras {
-        summary: [("calibration".to_string(), super::docs::calibration_summary(cal, wall_s)?)]
+        summary: [("calibration".to_string(), super::docs::calibration_summary(cal, law, wall_s)?)]
             .into_iter()
             .collect(),
-        html_sections: vec![calibration_html(cal, n, &figs)],
+        html_sections: vec![calibration_html(cal, law, n, &figs)],
     };
     let mut files = Files::default();
     files.add("calibration.toml", crate::calibrate::to_toml(cal)?);
@@ -102,7 +110,7 @@ pub fn per_impact_table(cal: &Calibration) -> Table {
 }
 
 /// The calibration section of report.html.
-fn calibration_html(cal: &Calibration, n: usize, figs: &[Captioned]) -> String {
+fn calibration_html(cal: &Calibration, law: Option<&LawReplay>, n: usize, figs: &[Captioned]) -> String {
     let mut s = format!(
         "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
         if cal.rocking == crate::wall::Rocking::OneSided { " and inward spring" } else { "" },
@@ -113,7 +121,7 @@ fn calibration_html(cal: &Calibration, n: usize, figs: &[Captioned]) -> String {
         cal.r_out,
         cal.e_housner
     );
-    s.push_str(&format!("<p>Restitution law: {}.</p>\n", escape(crate::calibrate::LAW_BY_REPLAY)));
+    s.push_str(&law_replay_html(law));
     if let Some(j) = &cal.joint {
         s.push_str(&format!(
             "<p>One joint fit over the same tests: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",
@@ -255,4 +263,45 @@ pub fn coefficients_figure(cal: &Calibration) -> Result<Figure, ReportError> {
         x_names: cal.tests.iter().map(|t| t.id.clone()).collect(),
     };
     plots::render(&[panel], 900, 450)
+}
+
+/// The law by replay in report.html: how it was fitted, then its notes.
+fn law_replay_html(law: Option<&LawReplay>) -> String {
+    let Some(l) = law else {
+        return "<p>Restitution law: not fitted by replay in this run.</p>\n".into();
+    };
+    let mut s = format!("<p>Restitution law {}.</p>\n<ul>\n", escape(crate::law_replay::LAW_BY_REPLAY));
+    for n in &l.notes {
+        s.push_str(&format!("<li>{}</li>\n", escape(n)));
+    }
+    for t in &l.tests {
+        let v: Vec<String> = t
+            .sides
+            .iter()
+            .map(|x| match &x.reason {
+                None => format!("{}: r_inf {:.4}, c {:.4} ± {:.4}", x.side, x.r_inf, x.c, x.cov[1][1].max(0.0).sqrt()),
+                Some(_) => format!(
+                    "{}: constant {:.4} (c {:.4} ± {:.4} not separated)",
+                    x.side,
+                    x.constant_r,
+                    x.c,
+                    x.cov[1][1].max(0.0).sqrt()
+                ),
+            })
+            .collect();
+        s.push_str(&format!(
+            "<li>test {}: {} impacts over a = {:.3}–{:.3}, RMS {:.3} mm (constant pair {:.3} mm); {}</li>\n",
+            escape(&t.id),
+            t.impacts,
+            t.amplitude_min,
+            t.amplitude_max,
+            t.law_rms_mm,
+            t.constant_rms_mm,
+            escape(&v.join("; "))
+        ));
+    }
+    for (id, why) in &l.failed {
+        s.push_str(&format!("<li>test {}: no law by replay: {}</li>\n", escape(id), escape(why)));
+    }
+    s + "</ul>\n"
 }

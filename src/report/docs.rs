@@ -99,13 +99,16 @@ struct CalibrationDoc<'a> {
     per_impact: Vec<PerImpact<'a>>,
     failed: Vec<Failure<'a>>,
     wall_s: f64,
-    /// Why the restitution law is not fitted by replay (issue 20).
+    /// How the restitution law is fitted by replay (issue 20).
     law_by_replay: &'static str,
+    /// The law by replay ([`crate::law_replay::LawReplay`]), absent where not fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    law_replay: Option<&'a crate::law_replay::LawReplay>,
 }
 
 /// The `"calibration"` entry that `rocklab calibrate` adds to `summary.json`;
 /// `wall_s` is how long the calibration took. Each test is its [`TestFit`].
-pub fn calibration_summary(cal: &Calibration, wall_s: f64) -> Result<Value, ReportError> {
+pub fn calibration_summary(cal: &Calibration, law: Option<&crate::law_replay::LawReplay>, wall_s: f64) -> Result<Value, ReportError> {
     super::json_value(&CalibrationDoc {
         e_in: cal.e_in,
         e_out: cal.e_out,
@@ -118,7 +121,12 @@ pub fn calibration_summary(cal: &Calibration, wall_s: f64) -> Result<Value, Repo
         per_impact: cal.per_impact.iter().map(|(id, i, o)| PerImpact { id, inward: i, outward: o }).collect(),
         failed: cal.failed.iter().map(|(id, e)| Failure { id, error: e }).collect(),
         wall_s,
-        law_by_replay: crate::calibrate::LAW_BY_REPLAY,
+        law_by_replay: if law.is_some() {
+            crate::law_replay::LAW_BY_REPLAY
+        } else {
+            "not fitted by replay in this run"
+        },
+        law_replay: law,
     })
 }
 

@@ -111,9 +111,10 @@ fn random_rigid_tests_full_draw() {
 }
 
 /// 200 tests with finite-duration lossy contacts (the compliant generator): none
-/// more than 5 pp off with status ok. The success rate (60 % when this was
-/// written) is printed, not asserted: this family is where the estimator's
-/// contact model is still weak (README).
+/// more than 5 pp off with status ok. Measured 75.5 % ok within 1 pp, 20
+/// flagged, worst ok 3.02 pp (draw 1181; docs/accuracy.md). The success rate is
+/// printed, asserted only above 55 %: this family is where the estimator's
+/// contact model is still weak.
 #[test]
 #[ignore = "the full compliant draw: run in release (see the module docs)"]
 fn random_compliant_tests_full_draw() {
@@ -273,4 +274,20 @@ fn fir_tests_once_missed_are_reduced() {
     let (rate, off) = summarise_logged("fir once missed", &scored);
     assert_eq!(off, 0);
     assert!(rate >= 0.99, "{rate}");
+}
+
+/// Compliant draws whose rounded contacts were taken for an unstated logger
+/// filter (status ok, 1.8–5.8 pp off) before the contact-phase model became the
+/// filter's rival (`peaks::acquisition::rival`): none is ok and more than 2 pp
+/// off now (each is flagged: the contacts fit its log as well as the filter).
+#[test]
+fn compliant_tests_once_taken_for_a_filter() {
+    let scored: Vec<Scored> = [1021, 1065, 1046, 1073]
+        .into_par_iter()
+        .map(|i| score(&draw(i, Family::Compliant)))
+        .collect();
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);
+    }
 }

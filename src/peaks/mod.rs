@@ -466,6 +466,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             if let Some((_, other)) = &est.runner_up {
                 uncertainty::add_model_spread(&mut c, &impacts, other);
             }
+            if let Some((other, _)) = &est.contact_rival {
+                uncertainty::add_model_spread(&mut c, &impacts, other);
+            }
         }
         c
     });

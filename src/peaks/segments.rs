@@ -96,6 +96,8 @@ impl SegmentFit {
         let extra = if one_sided { 6.0 } else { 3.0 };
         let mut chosen = simple.clone();
         let mut contacts = false;
+        // The best contact-phase fit, chosen or not: the rival of an estimated filter.
+        let mut best_contacts: Option<Fitted> = None;
         // Contact phases are fitted only where the instantaneous-impact model
         // misses the samples around its impacts by more than 1.2 σ (RMS):
         // finite-duration contacts show there first, and on a log fitted to
@@ -118,8 +120,11 @@ impl SegmentFit {
             let gain = (simple.fit.cost - c.fit.cost) / sigma2;
             let needed = if expected { 0.0 } else { extra * n.ln() };
             if gain > needed && c.fit.cost < chosen.fit.cost {
-                chosen = c;
+                chosen = c.clone();
                 contacts = true;
+            }
+            if best_contacts.as_ref().is_none_or(|b| c.fit.cost < b.fit.cost) {
+                best_contacts = Some(c);
             }
         }
         // Where contact phases were chosen, the instantaneous model's peaks give
@@ -129,7 +134,13 @@ impl SegmentFit {
         let mut alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
         // No filter stated: a low-pass rounds the kinks too.
         let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
-        let estimated = rival_filter(inp.estimate_filter && misses, &simple, &chosen, penalty, &tw, &yw, inp.sigma);
+        let rivals = super::acquisition::Rivals {
+            plain: &simple,
+            chosen: &chosen,
+            penalty,
+            contacts: best_contacts.as_ref(),
+        };
+        let estimated = rival_filter(inp.estimate_filter && misses, &rivals, &tw, &yw, inp.sigma);
         if let Some((e, _)) = &estimated {
             (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
         }
@@ -210,10 +221,9 @@ impl SegmentFit {
 /// Where `look` (no filter stated, the plain fit misses the samples around its
 /// impacts): an estimated low-pass, if it beats `chosen` ([`super::acquisition::rival`]).
 type Rival = Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>;
-fn rival_filter(look: bool, plain: &Fitted, chosen: &Fitted, penalty: f64, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
+fn rival_filter(look: bool, rivals: &super::acquisition::Rivals, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
     let dt = (tw[tw.len() - 1] - tw[0]) / (tw.len() - 1) as f64;
-    look.then(|| super::acquisition::rival(plain, chosen, penalty, tw, yw, dt, sigma))
-        .flatten()
+    look.then(|| super::acquisition::rival(rivals, tw, yw, dt, sigma)).flatten()
 }
 
 /// Isolated spikes the spike filter missed: a spike next to an impact, where the

@@ -117,8 +117,11 @@ pub const MAX_LATE_R_U: f64 = 0.05;
 /// reported where peaks k and k + 1 were read the same way (both resolved
 /// contacts, or, on two-sided walls, both kinks: a ratio of two readings of
 /// one kind cancels the bias they share; mixed kinds moved r by 0.03–0.08 on
-/// the MuJoCo campaigns, and on one-sided walls the kink reading of the two
-/// sides' different contacts alternates by ±0.07–0.1 in r). The readings stop
+/// the MuJoCo campaigns; on one-sided walls the ratio of two kink readings
+/// errs by about +0.06 (inward) and −0.05 (outward) of e on the early impacts
+/// and scatters by RMS 0.09–0.17 on the late ones: the restraint's side and the
+/// free arc's are read with different biases, docs/restitution-law.md and
+/// `tests/local_readings.rs::late_readings_by_side`). The readings stop
 /// at the first impact with no such pair, with e > 1, or with u(r) above
 /// [`MAX_LATE_R_U`]. Each r's uncertainty is propagated from its two readings'
 /// (independent local fits); consecutive impacts that use the same reading of

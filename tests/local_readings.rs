@@ -271,3 +271,84 @@ fn fresh_engine_campaigns() {
         every_impact_in(std::path::Path::new(dir)).print(dir);
     }
 }
+
+/// (reading kind or "ratio", k mod 2, k ≥ 5).
+type ErrorClass = (&'static str, usize, bool);
+
+/// Why one-sided late impacts are not read from kink readings (issue 20,
+/// docs/restitution-law.md, "Every impact"): every peak of each test of an
+/// engine-made campaign read locally ([`rocklab::peaks::late`]), each
+/// reading's relative error against the truth's velocity peak, by side (k even
+/// ends an outward half-cycle: on a one-sided wall the free arc, its impact on
+/// the base and the transverse walls; k odd ends an inward one: on a one-sided
+/// wall the short excursion into the transverse walls, its impact on the
+/// base), and the relative error of |v_{k+1}/v_k| from two kink readings (what
+/// a late r would be), for the late peaks (k ≥ 5) and the earlier ones.
+/// Printed; the campaign is `mujoco-public-one-sided` or the directory in
+/// `LATE_CAMPAIGN` (truth.json with `peaks`).
+/// `cargo test --test local_readings late_readings_by_side -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement, printed (docs/restitution-law.md)"]
+fn late_readings_by_side() {
+    use rocklab::ingest::Campaign;
+    use rocklab::peaks::late::Reading;
+    use rocklab::reduce::reduce_campaign;
+    let dir = match std::env::var("LATE_CAMPAIGN") {
+        Ok(d) => std::path::PathBuf::from(d),
+        Err(_) => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/mujoco-public-one-sided"),
+    };
+    let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let res = reduce_campaign(campaign, PeakOptions::default());
+    // (kind, side, late) -> relative errors and relative u; ("ratio", side of
+    // impact k, late) -> relative error of |v_{k+1}/v_k| from two kink readings.
+    let mut errs: std::collections::BTreeMap<ErrorClass, Vec<(f64, f64)>> = Default::default();
+    for t in &res.tests {
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
+        let peaks = tt["peaks"].as_array().unwrap();
+        let Ok(r) = t.result.as_ref() else { continue };
+        println!("{} ({})", t.spec.id, if r.analysis.quality.is_ok() { "ok" } else { "flagged" });
+        let mut previous: Option<(usize, f64)> = None;
+        for p in r.analysis.late_peaks(&r.log.time_s, t.spec.lever_arm_m * 1000.0, 0, 12) {
+            let Some(q) = peaks.get(p.k) else { break };
+            let (vt, tt_k) = (q["velocity_mm_s"].as_f64().unwrap(), q["time_s"].as_f64().unwrap());
+            let rel = |x: Option<Reading>| x.map(|x| (x.velocity_mm_s / vt - 1.0, x.u_mm_s / vt.abs()));
+            let show = |x: Option<(f64, f64)>| x.map_or("       -      ".to_string(), |(e, u)| format!("{e:+.3} ± {u:.3}"));
+            println!(
+                "  k{:<2} apex {:7.2} mm  truth {:7.1} mm/s, {:.1} ms before the crossing;  smooth {}  kink {}",
+                p.k,
+                p.apex_mm,
+                vt,
+                (p.crossing_s - tt_k) * 1e3,
+                show(rel(p.smooth)),
+                show(rel(p.kink))
+            );
+            let kink = rel(p.kink);
+            if let (Some((k0, e0)), Some((e1, u1))) = (previous, kink) {
+                errs.entry(("ratio", k0 % 2, k0 >= 5))
+                    .or_default()
+                    .push(((1.0 + e1) / (1.0 + e0) - 1.0, u1));
+            }
+            previous = kink.map(|x| (p.k, x.0));
+            for (kind, x) in [("smooth", rel(p.smooth)), ("kink", kink)] {
+                if let Some(x) = x {
+                    errs.entry((kind, p.k % 2, p.k >= 5)).or_default().push(x);
+                }
+            }
+        }
+    }
+    for ((kind, side, late), v) in &errs {
+        let n = v.len() as f64;
+        let mean = v.iter().map(|x| x.0).sum::<f64>() / n;
+        let rms = (v.iter().map(|x| x.0 * x.0).sum::<f64>() / n).sqrt();
+        let mut z: Vec<f64> = v.iter().map(|x| x.0.abs() / x.1).collect();
+        z.sort_by(f64::total_cmp);
+        println!(
+            "{kind:>6} k {} {}: {} readings, mean error {mean:+.3}, RMS {rms:.3}, median |err|/u {:.2}",
+            if *side == 0 { "even" } else { "odd " },
+            if *late { "k >= 5" } else { "k < 5 " },
+            v.len(),
+            z[z.len() / 2]
+        );
+    }
+}

@@ -649,7 +649,7 @@ pub const CONTACT_RATIO_BOUND: f64 = 0.03;
 /// fits the log at least as well (`excess`, its cost minus the filter's in σ²,
 /// ≤ 0) and the ratios of consecutive peaks differ by more than
 /// [`CONTACT_RATIO_BOUND`].
-fn contact_check(kind: Generic, cutoff_hz: f64, peaks: &[f64], other: &[f64], excess: f64) -> Option<String> {
+pub fn contact_check(kind: Generic, cutoff_hz: f64, peaks: &[f64], other: &[f64], excess: f64) -> Option<String> {
     let worst = ratio_difference(peaks, other);
     (worst > CONTACT_RATIO_BOUND && excess <= 0.0).then(|| {
         format!(

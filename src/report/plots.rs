@@ -365,15 +365,22 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
         .collect();
     // The constant first, so that the law is drawn over it: where the data do not
     // reject the constant the law is that constant and its line must still show.
+    // Where the law is that constant, one line says so (the law's would hide it).
+    let flat = law.iter().all(|&(_, r, _)| (r - constant).abs() <= 1e-12 * constant.abs().max(1.0));
     let span = law.first().zip(law.last()).map(|(a, b)| (lg(a.0), lg(b.0)));
-    if let Some((x0, x1)) = span {
+    if let Some((x0, x1)) = span.filter(|_| !flat) {
         series.push(Series::line(
             &format!("constant r = {constant:.3}"),
             PINK,
             vec![(x0, constant), (x1, constant)],
         ));
     }
-    series.push(Series::line("law r(a)", BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
+    let law_label = if flat {
+        format!("law r(a) = the constant {constant:.3}")
+    } else {
+        "law r(a)".to_string()
+    };
+    series.push(Series::line(&law_label, BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
     series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
     series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
     Panel::new(
@@ -382,4 +389,30 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
         "r = e / e_H",
         series,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn labels(p: &Panel) -> Vec<&str> {
+        p.series.iter().map(|s| s.label.as_str()).filter(|l| !l.is_empty()).collect()
+    }
+
+    /// A law that is the constant is one line that says so; a law that is not
+    /// is drawn beside the constant.
+    #[test]
+    fn law_panel_names_a_constant_law_once() {
+        let tests = vec![("t1".to_string(), vec![(0.1, 0.9)])];
+        let flat = [(0.01, 0.9, 0.01), (0.3, 0.9, 0.01)];
+        assert_eq!(
+            labels(&law_panel("x", &tests, &flat, 0.9)),
+            ["test t1", "law r(a) = the constant 0.900", "law ± u"]
+        );
+        let falling = [(0.01, 0.8, 0.01), (0.3, 0.95, 0.01)];
+        assert_eq!(
+            labels(&law_panel("x", &tests, &falling, 0.9)),
+            ["test t1", "constant r = 0.900", "law r(a)", "law ± u"]
+        );
+    }
 }

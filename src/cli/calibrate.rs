@@ -54,11 +54,9 @@ pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, 
     say(&to_markdown(&calibration_table(&cal)));
     if let Some(j) = &cal.joint {
         say(&format!(
-            "joint fit: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm",
-            j.e_in,
-            1.96 * j.se_e_in,
-            j.e_out,
-            1.96 * j.se_e_out,
+            "joint fit: e_in = {}, e_out = {} (95 %), RMS {:.3} mm",
+            rocklab::report::tables::value_u(j.e_in, 1.96 * j.se_e_in),
+            rocklab::report::tables::value_u(j.e_out, 1.96 * j.se_e_out),
             j.rms_mm
         ));
     }

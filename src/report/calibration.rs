@@ -124,11 +124,9 @@ fn calibration_html(cal: &Calibration, law: Option<&LawReplay>, n: usize, figs: 
     s.push_str(&law_replay_html(law));
     if let Some(j) = &cal.joint {
         s.push_str(&format!(
-            "<p>One joint fit over the same tests: e_in = {:.3} ± {:.3}, e_out = {:.3} ± {:.3} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",
-            j.e_in,
-            1.96 * j.se_e_in,
-            j.e_out,
-            1.96 * j.se_e_out,
+            "<p>One joint fit over the same tests: e_in = {}, e_out = {} (95 %), RMS {:.3} mm, {} iterations, {:?}.</p>\n",
+            super::tables::value_u(j.e_in, 1.96 * j.se_e_in),
+            super::tables::value_u(j.e_out, 1.96 * j.se_e_out),
             j.rms_mm,
             j.iterations,
             j.stop

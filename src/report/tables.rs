@@ -26,6 +26,19 @@ pub fn percent_u(v: f64, u: Option<f64>) -> String {
     }
 }
 
+/// "0.916 ± 0.012", or with as many decimals as the uncertainty's first
+/// significant digit needs ("0.9160 ± 0.0004"), so that a small u never reads
+/// "± 0.000"; at least three decimals, at most nine. A u that is not finite
+/// is said, never printed as NaN.
+pub fn value_u(v: f64, u: f64) -> String {
+    if !u.is_finite() {
+        return format!("{v:.3} (u not computed)");
+    }
+    let d = if u.is_finite() && u > 0.0 { (-u.log10().floor()) as i64 } else { 3 };
+    let d = d.clamp(3, 9) as usize;
+    format!("{v:.d$} ± {u:.d$}")
+}
+
 type Pick = fn(&Coefficients) -> f64;
 
 /// The columns of one campaign table: (CSV key, label, pick).
@@ -276,5 +289,18 @@ fn latex_label(name: &str) -> String {
         "r1_minus" => "$r_1^-$".into(),
         "r1" => "$r_1$".into(),
         other => latex_escape(other),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn value_u_shows_the_first_digit_of_a_small_u() {
+        assert_eq!(value_u(0.91612, 0.00037), "0.9161 ± 0.0004");
+        assert_eq!(value_u(0.916, 0.012), "0.916 ± 0.012");
+        assert_eq!(value_u(0.5, 0.0), "0.500 ± 0.000");
+        assert_eq!(value_u(0.5, f64::NAN), "0.500 (u not computed)");
     }
 }

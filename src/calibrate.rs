@@ -278,8 +278,18 @@ fn start_nuisance(geom: &Geometry, kappa: f64) -> Vec<f64> {
     q
 }
 
+/// The nuisance of a fitted test, packed as [`Nuisance`] reads it (the start
+/// of a longer or joint fit).
+pub(crate) fn nuisance_of(f: &TestFit, geom: &Geometry) -> Vec<f64> {
+    let mut q = vec![f.release_offset_s, f.zero_offset_mm, f.p2_factor.ln()];
+    if geom.one_sided {
+        q.push(f.kappa_per_s2.unwrap_or(12.0 * geom.p2).ln());
+    }
+    q
+}
+
 /// Finite-difference steps of the nuisance parameters.
-fn steps_nuisance(geom: &Geometry) -> Vec<f64> {
+pub(crate) fn steps_nuisance(geom: &Geometry) -> Vec<f64> {
     let mut s = vec![1e-6, 1e-5, 1e-7];
     if geom.one_sided {
         s.push(1e-6);
@@ -404,10 +414,7 @@ pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_
     };
     let mut steps = vec![1e-7; pack.n_e];
     for s in starts {
-        q0.extend([s.release_offset_s, s.zero_offset_mm, s.p2_factor.ln()]);
-        if geom.one_sided {
-            q0.push(s.kappa_per_s2.unwrap_or(12.0 * geom.p2).ln());
-        }
+        q0.extend(nuisance_of(s, geom));
         steps.extend(steps_nuisance(geom));
     }
     let refs: Vec<&TestWindow> = ws.iter().collect();

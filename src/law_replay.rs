@@ -40,7 +40,7 @@
 
 use std::sync::Arc;
 
-use crate::calibrate::{replay_with, window_to, CampaignInput, Geometry, Nuisance, TestFit, TestWindow};
+use crate::calibrate::{nuisance_of, replay_with, steps_nuisance, window_to, CampaignInput, Geometry, Nuisance, TestFit, TestWindow};
 use crate::fit::{least_squares, FitResult, FitStop};
 use crate::reduction::Reduced;
 use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, SideLaw, AMPLITUDE_FLOOR};
@@ -195,24 +195,6 @@ fn minus(w: &TestWindow, m: Option<Vec<f64>>) -> Option<Vec<f64>> {
     m.map(|m| w.x_mm.iter().zip(&m).map(|(a, b)| a - b).collect())
 }
 
-/// Finite-difference steps of the nuisance (as [`crate::calibrate`]).
-fn nuisance_steps(geom: &Geometry) -> Vec<f64> {
-    let mut s = vec![1e-6, 1e-5, 1e-7];
-    if geom.one_sided {
-        s.push(1e-6);
-    }
-    s
-}
-
-/// The nuisance of a constant fit, packed.
-fn nuisance_of(f: &TestFit, geom: &Geometry) -> Vec<f64> {
-    let mut q = vec![f.release_offset_s, f.zero_offset_mm, f.p2_factor.ln()];
-    if geom.one_sided {
-        q.push(f.kappa_per_s2.unwrap_or(12.0 * geom.p2).ln());
-    }
-    q
-}
-
 /// One side of a law fit by replay: the parameters, their covariance, and whether
 /// the replay separates them (module docs).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -308,7 +290,7 @@ fn constant_over(w: &TestWindow, geom: &Geometry, start: &TestFit, shared: bool)
     let mut q0 = if shared { vec![start.e_in] } else { vec![start.e_in, start.e_out] };
     q0.extend(nuisance_of(start, geom));
     let mut steps = vec![1e-7; n_e];
-    steps.extend(nuisance_steps(geom));
+    steps.extend(steps_nuisance(geom));
     let resid = |q: &[f64]| {
         let (ei, eo) = if shared { (q[0], q[0]) } else { (q[0], q[1]) };
         minus(w, crate::calibrate::replay(w, geom, ei, eo, Nuisance(&q[n_e..])))
@@ -336,7 +318,7 @@ pub fn fit_test_law(w: &TestWindow, hc: &[HalfCycle], geom: &Geometry, e_h: f64,
     };
     q0.extend(&nu);
     let mut steps = vec![1e-7; pack.n_law()];
-    steps.extend(nuisance_steps(geom));
+    steps.extend(steps_nuisance(geom));
     let resid = |q: &[f64]| minus(w, replay_law(w, geom, e_h, pack, q));
     let res = least_squares(&q0, &steps, MAX_ITER, &resid).ok()?;
     let amps: Vec<f64> = hc.iter().map(|h| (h.apex_mm / w.lever_mm).clamp(0.0, 1.0).asin() / geom.alpha).collect();

@@ -185,7 +185,7 @@ fn law_test(
     f64,
 ) {
     use rocklab::restitution_law::{LawForm, LawParameters, RestitutionLaw, SideLaw};
-    use rocklab::solver::{simulate_at, Ground, ImpactLaw, Restraint, RockingModel, Settings};
+    use rocklab::solver::{ImpactLaw, Restraint, RockingModel};
     use rocklab::wall::{p_squared_rectangular, slenderness};
     let (h, b, lever, fs, sigma, x0) = (2.47, 0.36, common::LEVER_MM, 200.0, 0.02, 130.0);
     let alpha = slenderness(b, h);
@@ -221,15 +221,8 @@ fn law_test(
     };
     let (t_r, dur) = (0.5 + 0.37 / fs, 8.0);
     let t: Vec<f64> = (0..(dur * fs) as usize).map(|i| i as f64 / fs).collect();
-    let ground = Ground {
-        t0: 0.0,
-        dt: 1.0,
-        acc: vec![0.0, 0.0],
-    };
-    let mut settings = Settings::new(dur).with_tolerances(1e-11, 1e-14);
-    settings.rest_speed = 1e-9;
     let th0 = (x0 / lever).asin();
-    let (_, th) = simulate_at(&model, &ground, t_r, Some([th0, 0.0]), &settings, &t).unwrap();
+    let (_, th) = common::free_rocking(&model, &t, t_r, th0, dur);
     let mut rng = common::Rng(seed);
     let x: Vec<f64> = th.iter().map(|v| lever * v.sin() + sigma * rng.normal()).collect();
     let hc = rocklab::law_replay::half_cycles(&t, &x, t_r, 3.0 * sigma, 20.0 * sigma, 24);

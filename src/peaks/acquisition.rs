@@ -611,10 +611,10 @@ pub(super) fn add_cutoff_spread(cov: &mut [Vec<f64>], spread: &[Vec<f64>]) {
     }
 }
 
-/// Where the runner-up response, or the contact-phase model, fits the log
-/// nearly as well as the chosen response, the ratios of consecutive peaks
-/// (what the table values are made of) must agree between them to 0.01 (1 pp
-/// of e): otherwise the log cannot say which response the logger had, or
+/// Where the runner-up response fits the log nearly as well as the chosen
+/// response, the ratios of consecutive peaks (what the table values are made
+/// of) must agree between them to 0.01 (1 pp of e); where the contact-phase
+/// model fits it at least as well, to [`CONTACT_RATIO_BOUND`]: otherwise the log cannot say which response the logger had, or
 /// whether the rounding of its impacts is the logger's or the wall's, and the
 /// test is suspect with that reason.
 pub fn family_check(est: &Estimate, peaks: &[f64]) -> Option<String> {
@@ -677,7 +677,8 @@ mod tests {
     use super::*;
 
     /// The contact-phase rival flags a test only where it fits at least as
-    /// well as the filter and the peak ratios differ by more than 0.01.
+    /// well as the filter and the peak ratios differ by more than
+    /// [`CONTACT_RATIO_BOUND`] (0.03).
     #[test]
     fn contact_rival_flags_only_an_equal_fit_that_changes_the_ratios() {
         let filter = [-500.0, 400.0, -320.0, 256.0];

@@ -3,7 +3,7 @@
 
 #![allow(dead_code)]
 
-use rocklab::solver::{simulate_at, Event, Ground, Restraint, RockingModel, Settings};
+use rocklab::solver::{simulate_at, Event, Ground, Restraint, RockingModel, Settings, Simulation};
 use rocklab::wall::{p_squared_rectangular, slenderness};
 
 /// Deterministic noise (xorshift + Box–Muller), so no extra crate.
@@ -37,6 +37,19 @@ pub struct LogSpec {
 /// The demo wall above its hinge: h = 2.47 m, b = 0.36 m, lever arm 2.33 m.
 pub const LEVER_MM: f64 = 2330.0;
 
+/// Free rocking of `model` released from rest at θ0 at `t_r`, the ground still,
+/// tight tolerances: the simulation and θ at each time of `t`.
+pub fn free_rocking(model: &RockingModel, t: &[f64], t_r: f64, theta0: f64, duration: f64) -> (Simulation, Vec<f64>) {
+    let ground = Ground {
+        t0: 0.0,
+        dt: 1.0,
+        acc: vec![0.0, 0.0],
+    };
+    let mut settings = Settings::new(duration).with_tolerances(1e-11, 1e-14);
+    settings.rest_speed = 1e-9;
+    simulate_at(model, &ground, t_r, Some([theta0, 0.0]), &settings, t).expect("valid settings")
+}
+
 /// A log (CSV text with `time_s,disp_mm`: hold, release at 1.3 s, rocking, rest;
 /// 8 s; quantised to 0.01 mm) and the exact velocity peaks L θ' before each impact.
 pub fn synthetic_log(s: &LogSpec) -> (String, Vec<f64>) {
@@ -62,14 +75,7 @@ pub fn synthetic_log(s: &LogSpec) -> (String, Vec<f64>) {
     let t: Vec<f64> = (0..n).map(|i| i as f64 / s.fs).collect();
     let t_r = 1.3 + 0.37 / s.fs;
     let theta0 = (s.x0_mm / LEVER_MM).asin();
-    let ground = Ground {
-        t0: 0.0,
-        dt: 1.0,
-        acc: vec![0.0, 0.0],
-    };
-    let mut settings = Settings::new(duration).with_tolerances(1e-11, 1e-14);
-    settings.rest_speed = 1e-9;
-    let (sim, th) = simulate_at(&model, &ground, t_r, Some([theta0, 0.0]), &settings, &t).expect("valid settings");
+    let (sim, th) = free_rocking(&model, &t, t_r, theta0, duration);
     let peaks = sim
         .events
         .iter()

@@ -86,6 +86,7 @@ mod quality;
 pub mod restraint;
 mod segments;
 mod uncertainty;
+mod vouch;
 
 use crate::signal::savgol::SavGol;
 use crate::signal::{median, noise_sigma};
@@ -486,7 +487,24 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Per impact: the local reading where the log resolves a smooth extreme.
     let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma);
+    let late = || {
+        late::read_late(
+            &late::LateInput {
+                t,
+                x: &p.x,
+                lever_mm: phys.lever_arm_mm,
+                sigma: p.sigma,
+                dt: p.dt,
+                release_s: fit.model().release_time(),
+                crossings: &p.crossings,
+            },
+            0,
+        )
+        .into_iter()
+        .take(n_peaks)
+        .collect()
+    };
+    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),

@@ -301,12 +301,6 @@ fn simulate<'py>(
             (None, calibration, e, e_in, e_out) => simulate_pair(&d, calibration, e, e_in, e_out)?,
         };
         let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
-        if polarity != 1 && polarity != -1 {
-            bail!("polarity = {polarity}: expected 1 or -1");
-        }
-        if !(scale.is_finite() && scale > 0.0) {
-            bail!("scale = {scale}: expected a positive number");
-        }
         let spec = RunSpec {
             e_in,
             e_out,
@@ -319,6 +313,7 @@ fn simulate<'py>(
             atol,
             keep_history: history,
         };
+        spec.check(|k| k.to_string()).map_err(anyhow::Error::msg)?;
         let (summary, sim) = run(&block, &record, &spec)?;
         let mut doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
         if let Some((l, e_h)) = law {

@@ -95,6 +95,16 @@ def test_array_errors_name_the_index():
         rocklab.simulate(BLOCK, {"acc": np.zeros(10), "dt": 0.01, "units": None}, e=0.9)
     with pytest.raises(rocklab.RocklabError, match="polarity = 3: expected 1 or -1"):
         rocklab.simulate(BLOCK, NRC_1030, e=0.9, polarity=3)
+    # The same ranges as the command line (rocklab::limits), so that a call from a
+    # script cannot ask for a run of 1e300 s or a record magnified 1e6 times.
+    for kwargs, message in [
+        ({"t_extra": 1e300}, r"t_extra = 1e300: expected a value from 0 to 3600 s"),
+        ({"scale": 1e6}, r"scale = 1e6: expected a value from 0.001 to 100"),
+        ({"rtol": 0.5}, r"rtol = 0.5: expected a value from 1e-12 to 0.001"),
+        ({"overturn_limit": float("nan")}, r"overturn_limit = NaN: expected a value"),
+    ]:
+        with pytest.raises(rocklab.RocklabError, match=message):
+            rocklab.simulate(BLOCK, NRC_1030, e=0.9, **kwargs)
     with pytest.raises(rocklab.RocklabError, match=r"\[wall\].thickness_m = -0.36"):
         rocklab.reduce_log(np.arange(100) * 0.005, np.zeros(100), wall={**m, "thickness_m": -0.36}, sensor_height_m=2.56)
 

@@ -109,6 +109,17 @@ def test_array_errors_name_the_index():
         rocklab.reduce_log(np.arange(100) * 0.005, np.zeros(100), wall={**m, "thickness_m": -0.36}, sensor_height_m=2.56)
 
 
+def test_facade_sizes_and_scales_within_the_cli_ranges():
+    # The command line's bounds (rocklab::limits), checked before any run starts:
+    # an ensemble of 10^9 samples or a scale of 1e9 from a script is refused.
+    with pytest.raises(rocklab.RocklabError, match=r"samples = 1000000000: expected at most 100000"):
+        rocklab.facade_ensembles(STUDY, samples=10**9)
+    with pytest.raises(rocklab.RocklabError, match=r"scales\[1\] = 1e9: expected a value from 0.001 to 100"):
+        rocklab.facade(STUDY, scales=[1.0, 1e9])
+    with pytest.raises(rocklab.RocklabError, match=r"scale = 1e9: expected a value from 0.001 to 100"):
+        rocklab.facade_runs(STUDY, [("20161030_ACC", "housner", 1, 1e9)], sensitivity=False)
+
+
 def test_a_flat_log_is_a_test_error_not_an_exception():
     res = rocklab.reduce_log(np.arange(400) * 0.005, np.zeros(400), wall={"height_m": 2.7, "thickness_m": 0.36}, sensor_height_m=2.56)
     assert res.test("log")["status"] == "error"

@@ -9,7 +9,7 @@
 //! | [`energy_gain`] | a peak is faster than the one before by more than 2 % + 3 u (free rocking only loses energy) |
 //! | [`impact_gains_speed`] | the speed after an impact exceeds the speed before it by more than 3 u (e > 1) |
 //! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise |
-//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ |
+//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`) |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |
 //! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 % |

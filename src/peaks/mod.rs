@@ -59,7 +59,8 @@
 //! reads L sin θ: 0.1 mm on a 150 mm release), and the impacts are located roughly
 //! by zero crossings with hysteresis (`prepare.rs`, `crossings.rs`). After it:
 //! the plausibility checks of [`checks`] (a test that trips one is
-//! [`Quality::Suspect`]) and the covariance of the peaks with its model-form
+//! [`Quality::Suspect`]; residuals that stand out around an impact only where
+//! local readings of the peaks do not vouch for them, `vouch.rs`) and the covariance of the peaks with its model-form
 //! terms (`uncertainty.rs`).
 //!
 //! Assumptions: free vibration (no base motion), the release from rest on the

@@ -114,7 +114,10 @@ fn add_twice_query_and_values_equal_summary() {
     let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
     assert!(page.contains("<svg") && page.contains("one-sided-demo") && page.contains("two-sided-demo"));
     // …and every impact's r against its amplitude (two panels, one per side).
-    assert!(page.contains(&format!("every archived impact ({} of tests with status ok)", listed.len())), "impact figure missing");
+    assert!(
+        page.contains(&format!("every archived impact ({} of tests with status ok)", listed.len())),
+        "impact figure missing"
+    );
     assert_eq!(page.matches("r against amplitude").count(), 2);
     // A bad query is an error, not a crash.
     let e = archive::query(&arc, "SELECT nope FROM tests").unwrap_err();

@@ -204,8 +204,8 @@ pub struct SideReplay {
     pub r_inf: f64,
     pub c: f64,
     pub cov: [[f64; 2]; 2],
-    /// Correlation of r∞ and c.
-    pub correlation: f64,
+    /// Correlation of r∞ and c (None where either has no spread).
+    pub correlation: Option<f64>,
     /// c / u(c).
     pub z: f64,
     /// The constant by replay over the same window (r = e/e_H) and its u.
@@ -219,7 +219,7 @@ pub struct SideReplay {
 /// The verdict of one side from its law and its constant (module docs).
 fn verdict(side: &'static str, law: [f64; 2], cov: [[f64; 2]; 2], constant: (f64, f64), span: (f64, f64)) -> SideReplay {
     let (u0, u1) = (cov[0][0].max(0.0).sqrt(), cov[1][1].max(0.0).sqrt());
-    let correlation = if u0 > 0.0 && u1 > 0.0 { cov[0][1] / (u0 * u1) } else { f64::NAN };
+    let correlation = (u0 > 0.0 && u1 > 0.0).then(|| cov[0][1] / (u0 * u1));
     let z = if u1 > 0.0 { law[1] / u1 } else { f64::NAN };
     let reason = if !z.is_finite() {
         Some("the replay gives c no uncertainty (the data do not constrain it)".to_string())
@@ -232,8 +232,12 @@ fn verdict(side: &'static str, law: [f64; 2], cov: [[f64; 2]; 2], constant: (f64
         let trend_u = u1 * (speed_shape(span.0) - speed_shape(span.1));
         Some(if trend_u > MAX_TREND_U {
             format!(
-                "the replay cannot separate r_inf from c over a = {:.3}–{:.3}: c = {:.2e} ± {:.2e} (c/u = {z:.2} < {Z_SEPARATE}; correlation of r_inf and c {correlation:.3}; the change of r across these amplitudes is uncertain by ± {trend_u:.3})",
-                span.0, span.1, law[1], u1
+                "the replay cannot separate r_inf from c over a = {:.3}–{:.3}: c = {:.2e} ± {:.2e} (c/u = {z:.2} < {Z_SEPARATE}; correlation of r_inf and c {}; the change of r across these amplitudes is uncertain by ± {trend_u:.3})",
+                span.0,
+                span.1,
+                law[1],
+                u1,
+                correlation.map_or("undefined".to_string(), |c| format!("{c:.3}"))
             )
         } else {
             format!(
@@ -557,7 +561,19 @@ fn test_outcome(t: &crate::calibrate::TestInput, fits: &[TestFit], geom: &Geomet
     let r = t.reduced.map_err(|e| format!("not reduced: {e}"))?;
     let fit = fits.iter().find(|f| f.id == t.id).ok_or("no constant fit to start from")?;
     let (w, hc) = law_window(t.id, r, t.lever_arm_m * 1e3).ok_or("fewer than three half-cycles above the noise")?;
-    fit_test_law(&w, &hc, geom, e_h, fit).ok_or_else(|| "the law replay failed (a replay outside the model's domain)".to_string())
+    let law = fit_test_law(&w, &hc, geom, e_h, fit).ok_or_else(|| "the law replay failed (a replay outside the model's domain)".to_string())?;
+    let finite = |s: &SideReplay| {
+        [s.r_inf, s.c, s.z, s.constant_r, s.constant_u]
+            .into_iter()
+            .chain(s.cov.into_iter().flatten())
+            .all(f64::is_finite)
+    };
+    if !law.sides.iter().all(finite) {
+        // A singular information matrix (block() gives NaN) or c without an
+        // uncertainty: no number of it can be vouched for, and no output may hold NaN.
+        return Err("the law replay does not constrain (r_inf, c): its covariance is singular".into());
+    }
+    Ok(law)
 }
 
 #[cfg(test)]

@@ -288,3 +288,18 @@ fn law_by_replay_recovers_its_own_law() {
         }
     }
 }
+
+/// A fit that drives the wall's frequency parameter p² up by 10¹⁴ (what a
+/// mutated log whose time column was scaled by 10⁻³ did: 2.1 million steps and
+/// 39,000 impacts per replay, and `calibrate` ran for hours) has its replay
+/// given up at `replay_step_budget` steps instead; the same window at the
+/// geometry's p² replays as before.
+#[test]
+fn a_replay_that_runs_away_is_given_up() {
+    let (w, _, geom, _) = law_test(None, 6);
+    let nominal = [0.0, 0.0, 0.0];
+    assert!(rocklab::calibrate::replay(&w, &geom, 0.9, 0.9, rocklab::calibrate::Nuisance(&nominal)).is_some());
+    let runaway = [0.0, 0.0, (1e14f64).ln()];
+    assert!(rocklab::calibrate::replay(&w, &geom, 0.999, 0.999, rocklab::calibrate::Nuisance(&runaway)).is_none());
+    assert!(rocklab::calibrate::replay_step_budget(w.t.len()) < 1_000_000);
+}

@@ -670,7 +670,7 @@ fn mujoco_law_by_replay() {
             );
             for s in &t.sides {
                 println!(
-                    "    {}: r_inf {:.4} ± {:.4}, c {:.4} ± {:.4} (rho {:.3}, z {:.1}); constant {:.4}; {}",
+                    "    {}: r_inf {:.4} ± {:.4}, c {:.4} ± {:.4} (rho {:?}, z {:.1}); constant {:.4}; {}",
                     s.side,
                     s.r_inf,
                     s.cov[0][0].sqrt(),

@@ -54,6 +54,9 @@ pub struct Settings {
     /// Stop at rest once no later sample can uplift the wall (|ü_g| ≤ g tan α
     /// from there on): it stays at rest, so the run's result is already known.
     pub stop_at_rest: bool,
+    /// Integration steps after which the run ends with [`SolverError::Steps`]
+    /// ([`MAX_STEPS`] by default; a replay inside a fit sets a budget of its own).
+    pub max_steps: usize,
 }
 
 impl Settings {
@@ -65,6 +68,7 @@ impl Settings {
             max_step: 0.01,
             keep_history: true,
             stop_at_rest: true,
+            max_steps: MAX_STEPS,
         }
     }
     /// Relative and absolute tolerances (checked by [`Settings::validate`]).
@@ -231,8 +235,8 @@ pub fn simulate_at(
 }
 
 /// The event loop: [`Loop::step`] until it says the run stopped.
-/// Bounded: [`MAX_REJECTIONS`] rejections in a row or [`MAX_STEPS`] steps end it
-/// with an error.
+/// Bounded: [`MAX_REJECTIONS`] rejections in a row or [`Settings::max_steps`]
+/// (at most [`MAX_STEPS`]) steps end it with an error.
 fn simulate_inner(
     model: &RockingModel,
     ground: &Ground,
@@ -259,7 +263,7 @@ fn simulate_inner(
                 rejections,
             });
         }
-        if run.sim.steps >= MAX_STEPS {
+        if run.sim.steps >= settings.max_steps.min(MAX_STEPS) {
             return Err(SolverError::Steps {
                 t: run.t,
                 t_end: settings.t_end,

@@ -125,7 +125,8 @@ pub const MAX_LATE_R_U: f64 = 0.05;
 /// at the first impact with no such pair, with e > 1, or with u(r) above
 /// [`MAX_LATE_R_U`]. Each r's uncertainty is propagated from its two readings'
 /// (independent local fits); consecutive impacts that use the same reading of
-/// their shared peak carry its negative correlation.
+/// their shared peak carry its negative correlation. The reduction uses this on
+/// two-sided walls, and [`extend_late_contacts`] on one-sided ones.
 pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &Geometry, two_sided: bool) {
     if late.first().map(|p| p.k) != Some(table.impacts.len()) {
         return;

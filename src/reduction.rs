@@ -90,7 +90,9 @@ pub const MAX_IMPACT_PEAKS: usize = 12;
 /// Every impact the log resolves: the table's analysis gives the impacts
 /// between its peaks (n − 1 of them), and the later ones come from the peaks
 /// after it, each read from the samples around it
-/// ([`crate::peaks::late`], [`crate::impacts::extend_late`]), up to
+/// ([`crate::peaks::late`], [`crate::impacts::extend_late`]; one-sided walls
+/// with the contact model, [`crate::peaks::late::contact_peaks`],
+/// [`crate::impacts::extend_late_contacts`]), up to
 /// [`MAX_IMPACT_PEAKS`]. Only the default estimator's ok tests are extended (a
 /// suspect test keeps its own analysis' impacts; the Savitzky–Golay estimator
 /// its own peaks).

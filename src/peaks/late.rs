@@ -44,8 +44,17 @@
 //! tall (noise-level motion: no impact to read), or whose speed exceeds the
 //! previous peak's (free rocking only loses speed).
 //!
+//! # One-sided walls
+//! Neither reading suits a one-sided wall's late peaks: its half-cycles end in
+//! contacts of 7–55 ms whose velocity turns a few ms before θ = 0, and at the
+//! end of the push into the transverse walls the kink's cubic overshoots
+//! (+0.056 on average on the public MuJoCo campaign). [`read_contact`] reads
+//! them with a model of the half-cycle's free motion and of the contact's force
+//! ([`FreeMotion`], docs/restitution-law.md).
+//!
 //! No crate does this: ordinary least squares (nalgebra) on windows chosen by
-//! the data, as in [`super::local`].
+//! the data, as in [`super::local`], over grids of the contact's onset and of
+//! the restraint's (λ, ω).
 
 use nalgebra::{DMatrix, DVector};
 

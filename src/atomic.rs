@@ -30,10 +30,35 @@ pub fn check_relative(rel: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Write `bytes` to `root/rel` atomically, after [`check_relative`] of `rel`.
+/// Write `bytes` to `root/rel` atomically, after [`check_relative`] of `rel` and
+/// [`check_no_link`] of its folders.
 pub fn write_under(root: &Path, rel: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    check_relative(rel).map_err(|why| std::io::Error::new(std::io::ErrorKind::InvalidInput, why))?;
+    let refuse = |why| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
+    check_relative(rel).map_err(refuse)?;
+    check_no_link(root, rel).map_err(refuse)?;
     write_atomic(&root.join(rel), bytes)
+}
+
+/// Why `root/rel` would be written through a symbolic link, if it would: a
+/// folder between `root` and the file that already exists as a link (say
+/// `out/plots -> /etc`) would carry the write outside the output folder. The
+/// file itself may be a link: the rename replaces the link, not its target.
+pub fn check_no_link(root: &Path, rel: &Path) -> Result<(), String> {
+    let mut at = root.to_path_buf();
+    let folders = rel.parent().into_iter().flat_map(|p| p.components());
+    for c in folders {
+        at.push(c);
+        match std::fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => {
+                return Err(format!(
+                    "{} is a symbolic link: refusing to write through it (outputs stay under the output folder)",
+                    at.display()
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// Write `bytes` to `path` atomically (temporary sibling, fsync, rename).
@@ -81,5 +106,25 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         write_under(&root, Path::new("plots/a.svg"), b"x").unwrap();
         assert!(root.join("plots/a.svg").exists());
+    }
+
+    // A folder under the output that is a link to elsewhere is not written through;
+    // a file that is a link is replaced, its target left alone.
+    #[cfg(unix)]
+    #[test]
+    fn refuses_to_write_through_a_linked_folder() {
+        let dir = tempfile::tempdir().unwrap();
+        let (root, elsewhere) = (dir.path().join("out"), dir.path().join("elsewhere"));
+        std::fs::create_dir_all(&root).unwrap();
+        std::fs::create_dir_all(&elsewhere).unwrap();
+        std::os::unix::fs::symlink(&elsewhere, root.join("plots")).unwrap();
+        let err = write_under(&root, Path::new("plots/a.svg"), b"x").unwrap_err();
+        assert!(err.to_string().contains("symbolic link"), "{err}");
+        assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0);
+        std::fs::write(elsewhere.join("target.txt"), b"keep").unwrap();
+        std::os::unix::fs::symlink(elsewhere.join("target.txt"), root.join("summary.json")).unwrap();
+        write_under(&root, Path::new("summary.json"), b"new").unwrap();
+        assert_eq!(std::fs::read(elsewhere.join("target.txt")).unwrap(), b"keep");
+        assert_eq!(std::fs::read(root.join("summary.json")).unwrap(), b"new");
     }
 }

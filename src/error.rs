@@ -203,7 +203,13 @@ fn locate(text: &str, message: &str) -> Option<(usize, usize)> {
 /// line is not quoted whole); control characters are shown escaped.
 pub fn excerpt(value: &str, max: usize) -> String {
     let n = value.chars().count();
-    let shown: String = value.chars().take(max).flat_map(char::escape_debug).collect();
+    // Only control characters are escaped: `escape_debug` on every character
+    // also turned the quotes of a TOML line into \" (`cutoff_hz = \"x\"`).
+    let shown: String = value
+        .chars()
+        .take(max)
+        .flat_map(|c| if c.is_control() { c.escape_debug().collect::<Vec<_>>() } else { vec![c] })
+        .collect();
     if n > max {
         format!("{shown}… ({n} characters)")
     } else {
@@ -252,6 +258,14 @@ mod tests {
         );
         let short = InputError::Missing { file: "a/b.csv".into() }.to_string();
         assert!(short.starts_with("a/b.csv: file not found"), "{short}");
+    }
+
+    #[test]
+    fn an_excerpt_escapes_control_characters_only() {
+        assert_eq!(excerpt("cutoff_hz = \"x\"", 60), "cutoff_hz = \"x\"");
+        assert_eq!(excerpt("a\0b\nc", 60), "a\\0b\\nc");
+        assert_eq!(excerpt("é'7", 60), "é'7");
+        assert_eq!(excerpt(&"7".repeat(100), 3), "777… (100 characters)");
     }
 
     const TEXT: &str = "[campaign]\nname = \"c\"\n[wall]\nheight_m = 2.7\n  thickness_m = -0.36\n[[test]]\nid = \"a\"\n[[test]]\nid = \"b\"\n";

@@ -269,6 +269,27 @@ pub fn parse_scales(s: &str) -> Result<Vec<f64>, ScalesError> {
     Ok((0..n).map(|i| from + (to - from) * i as f64 / (n - 1) as f64).collect())
 }
 
+/// A list of scale factors given as numbers (Python): at most
+/// [`crate::limits::MAX_SCALES`], each within [`crate::limits::MAGNIFICATION`],
+/// as [`parse_scales`] allows on the command line.
+pub fn check_scale_list(scales: &[f64]) -> Result<(), String> {
+    if scales.len() > crate::limits::MAX_SCALES {
+        return Err(format!("{} scales: expected at most {}", scales.len(), crate::limits::MAX_SCALES));
+    }
+    for (i, &sc) in scales.iter().enumerate() {
+        crate::limits::MAGNIFICATION.check(&format!("scales[{i}]"), sc)?;
+    }
+    Ok(())
+}
+
+/// An ensemble's size `n` (samples per row) within [`crate::limits::MAX_SAMPLES`].
+pub fn check_samples(name: &str, n: usize) -> Result<(), String> {
+    if n > crate::limits::MAX_SAMPLES {
+        return Err(format!("{name} = {n}: expected at most {}", crate::limits::MAX_SAMPLES));
+    }
+    Ok(())
+}
+
 /// One IDA point: max θ/α (∞-free: an overturned run reports its peak, 1 at the
 /// default limit) and whether it overturned.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -469,20 +469,31 @@ fn notes(sides: &[SideReplay], span: (f64, f64)) -> Vec<String> {
         .iter()
         .map(|s| match &s.reason {
             None => format!(
-                "side {}: r(a) = {:.4} − {:.4} g(a) by replay over a = {:.3}–{:.3} (r = {:.3} at a = {:.3}, {:.3} at a = {:.3}); extrapolated outside",
+                "side {}: r(a) = {:.4} − {:.4} g(a) by replay over a = {:.3}–{:.3} ({}); extrapolated outside",
                 s.side,
                 s.r_inf,
                 s.c,
                 span.0,
                 span.1,
-                (s.r_inf - s.c * speed_shape(span.0)).max(0.0),
-                span.0,
-                (s.r_inf - s.c * speed_shape(span.1)).max(0.0),
-                span.1
+                law_ends(s.r_inf, s.c, span)
             ),
             Some(why) => format!("side {}: constant r = {:.4} ± {:.4} by replay: {why}", s.side, s.constant_r, s.constant_u),
         })
         .collect()
+}
+
+/// The law r∞ − c g(a) at both ends of `span`, in words. Where it falls to 0
+/// inside the span (the solver then stops the wall: r is clamped at 0), the
+/// amplitude at which it does is said instead of a row of zeros:
+/// g(a₀) = r∞/c ⇔ a₀ = 1 − √(1 − (c/r∞)²).
+fn law_ends(r_inf: f64, c: f64, span: (f64, f64)) -> String {
+    let r = |a: f64| r_inf - c * speed_shape(a);
+    let top = format!("r = {:.3} at a = {:.3}", r(span.1).max(0.0), span.1);
+    if r(span.0) > 0.0 || r_inf <= 0.0 || c <= 0.0 {
+        return format!("r = {:.3} at a = {:.3}, {top}", r(span.0).max(0.0), span.0);
+    }
+    let a0 = 1.0 - (1.0 - (c / r_inf).powi(2)).max(0.0).sqrt();
+    format!("{top}; it falls to 0 at a = {a0:.4}, inside the span: below that the law stops the wall")
 }
 
 /// Fits the law by replay on every included test of a campaign whose constant
@@ -551,6 +562,15 @@ fn test_outcome(t: &crate::calibrate::TestInput, fits: &[TestFit], geom: &Geomet
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_law_s_ends_say_where_it_falls_to_zero() {
+        let s = super::law_ends(1.0349, 0.0568, (0.001, 0.36));
+        assert!(s.contains("falls to 0 at a = 0.0015"), "{s}");
+        assert!(!s.contains("r = 0.000"), "{s}");
+        let s = super::law_ends(1.0, 0.02, (0.05, 0.36));
+        assert!(s.starts_with("r = 0.936 at a = 0.050, r = 0.974 at a = 0.360"), "{s}");
+    }
+
     use super::*;
 
     /// Crossings with hysteresis, the apex of each half-cycle, and the stop at a

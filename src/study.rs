@@ -28,6 +28,29 @@ pub struct RunSpec {
     pub keep_history: bool,
 }
 
+impl RunSpec {
+    /// The run's settings within `crate::limits` (magnification, tolerances,
+    /// t_extra, overturning limit) and polarity ±1, or a message naming the first
+    /// that is not; `name` gives each setting's name as its caller spells it
+    /// (`--scale` on the command line, `scale` in Python).
+    pub fn check(&self, name: impl Fn(&str) -> String) -> Result<(), String> {
+        use crate::limits;
+        if self.polarity != 1.0 && self.polarity != -1.0 {
+            return Err(format!("{} = {}: expected 1 or -1", name("polarity"), self.polarity));
+        }
+        for (key, v, range) in [
+            ("scale", self.scale, limits::MAGNIFICATION),
+            ("rtol", self.rtol, limits::RTOL),
+            ("atol", self.atol, limits::ATOL),
+            ("t_extra", self.t_extra, limits::T_EXTRA_S),
+            ("overturn_limit", self.overturn_limit, limits::ANGLE_RAD),
+        ] {
+            range.check(&name(key), v)?;
+        }
+        Ok(())
+    }
+}
+
 /// The summary of a run.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct RunSummary {

@@ -81,8 +81,25 @@ fn add_twice_query_and_values_equal_summary() {
             assert_eq!(nums(&tests, "slenderness")[i], Some(slender));
         }
     }
-    // The demo summaries' impacts are not (yet) in SPEC's per-impact shape: no rows.
-    assert_eq!(impacts.height(), 0);
+    // Every impact of summary.json with a coefficient (side, e, r) is a row, value
+    // for value; an impact without one (its next peak not read) is not. (The
+    // archive once skipped a whole test for one such impact: zero rows.)
+    let listed: Vec<&Value> = docs
+        .iter()
+        .flat_map(|d| d["tests"].as_array().unwrap())
+        .flat_map(|t| t["impacts"].as_array().unwrap())
+        .filter(|i| i["side"].is_string())
+        .collect();
+    assert!(listed.len() >= 50, "only {} impacts with a coefficient in the demos", listed.len());
+    assert_eq!(impacts.height(), listed.len(), "{impacts}");
+    let mut archived: Vec<(Option<f64>, Option<f64>)> = nums(&impacts, "e").into_iter().zip(nums(&impacts, "r_u")).collect();
+    let mut summary: Vec<(Option<f64>, Option<f64>)> = listed.iter().map(|i| (i["e"].as_f64(), i["r_u"].as_f64())).collect();
+    let key = |v: &(Option<f64>, Option<f64>)| (v.0.unwrap().to_bits(), v.1.unwrap().to_bits());
+    archived.sort_by_key(key);
+    summary.sort_by_key(key);
+    assert_eq!(archived, summary);
+    // `reduce` writes the same rows beside its CSVs.
+    assert!(one.join("impacts.parquet").exists() && two.join("impacts.parquet").exists());
     let out = run(&[
         "archive",
         "query",
@@ -96,6 +113,12 @@ fn add_twice_query_and_values_equal_summary() {
     // The archive page plots them.
     let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
     assert!(page.contains("<svg") && page.contains("one-sided-demo") && page.contains("two-sided-demo"));
+    // …and every impact's r against its amplitude (two panels, one per side).
+    assert!(
+        page.contains(&format!("every archived impact ({} of tests with status ok)", listed.len())),
+        "impact figure missing"
+    );
+    assert_eq!(page.matches("r against amplitude").count(), 2);
     // A bad query is an error, not a crash.
     let e = archive::query(&arc, "SELECT nope FROM tests").unwrap_err();
     assert!(matches!(e, ArchiveError::Sql(_)), "{e}");

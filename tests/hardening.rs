@@ -209,3 +209,26 @@ fn an_io_error_is_said_once() {
     assert_eq!(code, 2);
     assert_eq!(stderr.matches("os error 21").count(), 1, "{stderr}");
 }
+
+// A folder of --out that is a symbolic link (`out/plots -> elsewhere`, left by
+// another tool) would carry the plots outside --out: the run is refused, naming
+// the link, and nothing is written, there or under --out.
+#[cfg(unix)]
+#[test]
+fn a_linked_folder_under_out_is_not_written_through() {
+    let root = tempfile::tempdir().unwrap();
+    let (out, elsewhere) = (root.path().join("out"), root.path().join("elsewhere"));
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::create_dir_all(&elsewhere).unwrap();
+    std::os::unix::fs::symlink(&elsewhere, out.join("plots")).unwrap();
+    let (code, stderr) = run(&[
+        "reduce".as_ref(),
+        fixtures().join("campaigns/one-sided-demo/campaign.toml").as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("symbolic link"), "{stderr}");
+    assert_eq!(tree(&elsewhere).len(), 0, "written through the link");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "something written under --out");
+}

@@ -2,8 +2,11 @@
 """Mutation driver of issue 22 (not run by CI; docs/hardening.md).
 
 Makes N mutated inputs from the fixtures — displacement logs and campaign
-manifests (`reduce`), ground-motion records and block files (`simulate`), study
-files (`facade`) — of the kinds that found the defects of issue 22: scaled
+manifests (`reduce`), the loggers' binary formats (TDMS, MAT v5 and v7.3,
+Parquet, Excel: byte flips, truncation, zeroed blocks, `reduce`), `[acquisition]`
+tables with hostile values (`reduce`), campaigns to `calibrate`, reductions'
+summary.json for `archive add`, ground-motion records and block files
+(`simulate`), study files (`facade`) — of the kinds that found the defects of issue 22: scaled
 columns, huge/tiny/NaN/inf values, path-like names, NUL, truncation, long cells,
 wrong types. Runs the release binary on each in a fresh sandbox folder with a
 20 s limit and a 2 GiB address-space cap (`ulimit -v`), and checks:
@@ -127,8 +130,10 @@ def scale_column(rng, b):
 def case_inputs(rng, sandbox):
     """Write one case's inputs into `sandbox/work` and return (kind, description, argv)."""
     work = sandbox / "work"
-    kind = rng.choice(["log", "manifest", "record", "block", "study"])
+    kind = rng.choice(["log", "manifest", "record", "block", "study", "format", "acquisition", "calibrate", "archive"])
     out = work / "out" / "o"
+    if kind in ("format", "acquisition", "calibrate", "archive"):
+        return newer_case(rng, work, out, kind)
     if kind in ("log", "manifest"):
         camp = rng.choice(["one-sided-demo", "two-sided-demo"])
         shutil.copytree(FIX / "campaigns" / camp, work / "c")
@@ -164,6 +169,76 @@ def case_inputs(rng, sandbox):
     if rng.random() < 0.3:
         argv += ["--scales", rng.choice(["0.5:1.5:3", "1e-300:1e300:3", "1:2:100000000", "nan:1:3", "0.5:1:2"])]
     return kind, f"study.toml {desc}", argv
+
+
+FORMATS = ["tdms", "mat5", "mat73", "parquet", "xlsx"]
+FILTERS = ['"none"', '"bessel"', '"butterworth"', '"unknown"', '"fir"', '""', "4", '"../../x"']
+
+
+def mutate_binary(rng, b):
+    """One mutation of a binary file: flipped bytes, a zeroed or 0xFF block,
+    truncation, a duplicated chunk; returns (bytes, description)."""
+    op = rng.choice(["flip", "block", "truncate", "dup", "flip"])
+    p = rng.randrange(max(len(b), 1))
+    if op == "flip":
+        n = rng.choice([1, 4, 32])
+        bb = bytearray(b)
+        for _ in range(n):
+            q = rng.randrange(len(bb))
+            bb[q] ^= 1 << rng.randrange(8)
+        return bytes(bb), f"flip x{n}"
+    if op == "block":
+        n, v = rng.choice([8, 64, 4096]), rng.choice([b"\0", b"\xff"])
+        return b[:p] + v * n + b[p + n:], f"block@{p}+{n}:{v!r}"
+    if op == "truncate":
+        return b[:p], f"truncate@{p}"
+    n = rng.randrange(1, 4096)
+    return b[:p] + b[p:p + n] * rng.choice([2, 100]) + b[p + n:], f"dup@{p}+{n}"
+
+
+def acquisition_table(rng):
+    """An [acquisition] table (or per-test inline one) with hostile values."""
+    order = rng.choice(["4", "0", "-1", "1e9", "2.5", "99", '"four"', "nan"])
+    cut = rng.choice(["50.0", "0", "-1", "1e308", "nan", "inf", "1e-300", "99999", '"fast"', "100"])
+    return f"filter = {rng.choice(FILTERS)}\norder = {order}\ncutoff_hz = {cut}\n", f"order={order} cutoff={cut}"
+
+
+def newer_case(rng, work, out, kind):
+    """Cases for what came after the first mutation runs: binary formats,
+    [acquisition], calibrate, archive add."""
+    if kind == "format":
+        fmt = rng.choice(FORMATS)
+        shutil.copytree(FIX / "formats" / fmt, work / "c")
+        target = rng.choice(sorted(p for p in (work / "c").iterdir() if p.name != "campaign.toml"))
+        b, descs = target.read_bytes(), []
+        for _ in range(rng.choice([1, 1, 2])):
+            b, d = mutate_binary(rng, b)
+            descs.append(d)
+        target.write_bytes(b)
+        return kind, f"{fmt}/{target.name} {'; '.join(descs)}", ["reduce", str(work / "c" / "campaign.toml"), "--out", str(out), "--no-plots"]
+    camp = rng.choice(["one-sided-demo", "two-sided-demo"])
+    shutil.copytree(FIX / "campaigns" / camp, work / "c")
+    (work / "c" / "truth.json").unlink()
+    manifest = work / "c" / "campaign.toml"
+    if kind == "acquisition":
+        table, desc = acquisition_table(rng)
+        text = manifest.read_text()
+        if rng.random() < 0.5:
+            text = text.replace("[[test]]", "[acquisition]\n" + table + "\n[[test]]", 1)
+        else:
+            inline = "acquisition = { " + table.strip().replace("\n", ", ") + " }\n"
+            text = re.sub(r"(?m)^(file = .*\n)", lambda m: m.group(1) + inline, text, count=1)
+        manifest.write_text(text)
+        return kind, f"{camp} {desc}", ["reduce", str(manifest), "--out", str(out), "--no-plots"]
+    if kind == "calibrate":
+        target = rng.choice([manifest] + sorted((work / "c").glob("*.csv")))
+        desc = mutate_file(rng, target, "toml" if target == manifest else "text")
+        return kind, f"{camp}/{target.name} {desc}", ["calibrate", str(manifest), "--out", str(out)]
+    # archive: a reduction's summary.json, mutated, added to an archive under out.
+    red = work / "red"
+    subprocess.run([str(BIN), "reduce", str(manifest), "--out", str(red), "--no-plots"], capture_output=True, timeout=LIMIT_S)
+    desc = mutate_file(rng, red / "summary.json", rng.choice(["toml", "text"]))
+    return kind, f"{camp} summary.json {desc}", ["archive", "add", "--to", str(out), str(red)]
 
 
 def mutate_file(rng, path, kind):

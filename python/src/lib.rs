@@ -301,12 +301,6 @@ fn simulate<'py>(
             (None, calibration, e, e_in, e_out) => simulate_pair(&d, calibration, e, e_in, e_out)?,
         };
         let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
-        if polarity != 1 && polarity != -1 {
-            bail!("polarity = {polarity}: expected 1 or -1");
-        }
-        if !(scale.is_finite() && scale > 0.0) {
-            bail!("scale = {scale}: expected a positive number");
-        }
         let spec = RunSpec {
             e_in,
             e_out,
@@ -319,6 +313,7 @@ fn simulate<'py>(
             atol,
             keep_history: history,
         };
+        spec.check(|k| k.to_string()).map_err(anyhow::Error::msg)?;
         let (summary, sim) = run(&block, &record, &spec)?;
         let mut doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
         if let Some((l, e_h)) = law {
@@ -411,6 +406,9 @@ fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<Stri
 fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<String> {
     let doc = guarded(py, move || {
         let study = Study::load(&study)?;
+        if let Some(sc) = &scales {
+            rocklab::facade::check_scale_list(sc).map_err(anyhow::Error::msg)?;
+        }
         let start = Instant::now();
         let runs = run_study(&study, 1.0, false, &|| {})?;
         let wall = start.elapsed().as_secs_f64();
@@ -440,6 +438,11 @@ fn facade_ensembles(
         study.samples = samples.unwrap_or(study.samples);
         study.seed = seed.unwrap_or(study.seed);
         study.ida_samples = ida_samples.unwrap_or(study.ida_samples).max(1);
+        rocklab::facade::check_samples("samples", study.samples).map_err(anyhow::Error::msg)?;
+        rocklab::facade::check_samples("ida_samples", study.ida_samples).map_err(anyhow::Error::msg)?;
+        if let Some(sc) = &scales {
+            rocklab::facade::check_scale_list(sc).map_err(anyhow::Error::msg)?;
+        }
         let (rows, ens) = if study.samples > 0 {
             run_ensembles(&study, study.samples, &|| {})?
         } else {
@@ -531,9 +534,7 @@ fn facade_runs(py: Python<'_>, study: PathBuf, runs_json: &str, sensitivity: boo
             if *pol != 1 && *pol != -1 {
                 bail!("polarity {pol}: expected 1 or -1");
             }
-            if !(scale.is_finite() && *scale > 0.0) {
-                bail!("scale {scale}: expected a positive number");
-            }
+            rocklab::limits::MAGNIFICATION.check("scale", *scale).map_err(anyhow::Error::msg)?;
             subs.entry((r, s, *pol)).or_insert_with(|| Study {
                 records: vec![study.records[r].clone()],
                 sets: vec![study.sets[s].clone()],

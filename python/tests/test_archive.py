@@ -37,8 +37,17 @@ def _check(tests, impacts, docs):
             assert row["manifest_sha256"] == doc["manifest_sha256"]
             for k in ["r", "r_plus", "r_minus", "r_plus_u", "r_minus_u", "e", "r1", "r2"]:
                 assert row[k] == t[k], (t["id"], k)
-    assert len(_rows(impacts)) == 0  # the demo's impacts are not in SPEC's per-impact shape yet
-    assert "side" in list(impacts.columns)
+    # Every impact of summary.json with a coefficient (side, e, r) is a row, value for value.
+    listed = sorted(
+        (doc["campaign"], t["id"], i["k"], i["side"], i["e"], i["r_u"])
+        for doc in docs
+        for t in doc["tests"]
+        for i in t["impacts"]
+        if "side" in i
+    )
+    got = sorted((r["campaign"], r["test"], r["k"], r["side"], r["e"], r["r_u"]) for r in _rows(impacts))
+    assert len(listed) >= 50
+    assert got == listed
 
 
 def test_archive_tables_equal_summary(archive):

@@ -95,8 +95,29 @@ def test_array_errors_name_the_index():
         rocklab.simulate(BLOCK, {"acc": np.zeros(10), "dt": 0.01, "units": None}, e=0.9)
     with pytest.raises(rocklab.RocklabError, match="polarity = 3: expected 1 or -1"):
         rocklab.simulate(BLOCK, NRC_1030, e=0.9, polarity=3)
+    # The same ranges as the command line (rocklab::limits), so that a call from a
+    # script cannot ask for a run of 1e300 s or a record magnified 1e6 times.
+    for kwargs, message in [
+        ({"t_extra": 1e300}, r"t_extra = 1e300: expected a value from 0 to 3600 s"),
+        ({"scale": 1e6}, r"scale = 1e6: expected a value from 0.001 to 100"),
+        ({"rtol": 0.5}, r"rtol = 0.5: expected a value from 1e-12 to 0.001"),
+        ({"overturn_limit": float("nan")}, r"overturn_limit = NaN: expected a value"),
+    ]:
+        with pytest.raises(rocklab.RocklabError, match=message):
+            rocklab.simulate(BLOCK, NRC_1030, e=0.9, **kwargs)
     with pytest.raises(rocklab.RocklabError, match=r"\[wall\].thickness_m = -0.36"):
         rocklab.reduce_log(np.arange(100) * 0.005, np.zeros(100), wall={**m, "thickness_m": -0.36}, sensor_height_m=2.56)
+
+
+def test_facade_sizes_and_scales_within_the_cli_ranges():
+    # The command line's bounds (rocklab::limits), checked before any run starts:
+    # an ensemble of 10^9 samples or a scale of 1e9 from a script is refused.
+    with pytest.raises(rocklab.RocklabError, match=r"samples = 1000000000: expected at most 100000"):
+        rocklab.facade_ensembles(STUDY, samples=10**9)
+    with pytest.raises(rocklab.RocklabError, match=r"scales\[1\] = 1e9: expected a value from 0.001 to 100"):
+        rocklab.facade(STUDY, scales=[1.0, 1e9])
+    with pytest.raises(rocklab.RocklabError, match=r"scale = 1e9: expected a value from 0.001 to 100"):
+        rocklab.facade_runs(STUDY, [("20161030_ACC", "housner", 1, 1e9)], sensitivity=False)
 
 
 def test_a_flat_log_is_a_test_error_not_an_exception():

@@ -174,7 +174,7 @@ pub fn add_with_hook(archive: &Path, report_dirs: &[PathBuf], hook: &mut dyn FnM
     }
     let (tests_rows, impacts_rows) = (tables[0].1.height(), tables[1].1.height());
     commit(archive, &mut tables, hook)?;
-    if let Err(e) = page::write(archive, &tables[0].1) {
+    if let Err(e) = page::write(archive, &tables[0].1, &tables[1].1) {
         notes.push(format!("archive.html not written: {e}"));
     }
     Ok(Added {

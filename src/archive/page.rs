@@ -1,7 +1,8 @@
 //! `ARCHIVE/archive.html`: a self-contained page (SVG inline) plotting every
 //! archived test's r⁺ and r⁻ against the wall's slenderness h/t, by rocking type,
-//! each with its band r ± 2u (u: the test's standard uncertainty, `_u`), and a table
-//! of the campaigns.
+//! each with its band r ± 2u (u: the test's standard uncertainty, `_u`), every
+//! archived impact's r against the amplitude of the half-cycle it ends (the
+//! restitution law's data across campaigns, issue 20), and a table of the campaigns.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -87,8 +88,65 @@ fn panel(points: &[Point], title: &str, y_label: &str, pick: fn(&Point) -> (f64,
     panel
 }
 
-/// Render the page from the `tests` table.
-pub fn render(tests: &DataFrame) -> Result<String, ArchiveError> {
+/// One archived impact of a test with status ok: (campaign, side, amplitude, r).
+type ImpactPoint = (String, String, f64, f64);
+
+/// The impacts of the tests with status ok, with amplitude and r known.
+fn impact_points(tests: &DataFrame, impacts: &DataFrame) -> PolarsResult<Vec<ImpactPoint>> {
+    let ok: std::collections::HashSet<(String, String)> = text(tests, "manifest_sha256")?
+        .into_iter()
+        .zip(text(tests, "test")?)
+        .zip(text(tests, "status")?)
+        .filter_map(|((sha, t), st)| (st.as_deref() == Some("ok")).then_some((sha?, t?)))
+        .collect();
+    let (sha, test, campaign, side) = (
+        text(impacts, "manifest_sha256")?,
+        text(impacts, "test")?,
+        text(impacts, "campaign")?,
+        text(impacts, "side")?,
+    );
+    let (a, r) = (numbers(impacts, "amplitude_over_alpha")?, numbers(impacts, "r")?);
+    let mut out = Vec::new();
+    for i in 0..impacts.height() {
+        let key = (sha[i].clone().unwrap_or_default(), test[i].clone().unwrap_or_default());
+        if let (true, Some(a), Some(r), Some(side)) = (ok.contains(&key), a[i], r[i], side[i].clone()) {
+            out.push((campaign[i].clone().unwrap_or_default(), side, a, r));
+        }
+    }
+    Ok(out)
+}
+
+/// r of every impact against its amplitude, a panel per side, a colour per campaign.
+fn impact_panels(points: &[ImpactPoint]) -> Vec<Panel> {
+    let campaigns: Vec<&str> = points
+        .iter()
+        .map(|p| p.0.as_str())
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    [("in", "entering the inward side"), ("out", "entering the outward side")]
+        .iter()
+        .map(|(side, title)| {
+            let series = campaigns
+                .iter()
+                .enumerate()
+                .filter_map(|(k, c)| {
+                    let pts: Vec<(f64, f64)> = points.iter().filter(|p| p.0 == *c && p.1 == *side).map(|p| (p.2, p.3)).collect();
+                    (!pts.is_empty()).then(|| Series::dots(c, plots::SETS[k % plots::SETS.len()], pts))
+                })
+                .collect();
+            Panel::new(
+                format!("impacts {title}: r against amplitude"),
+                "amplitude |θ|/α of the half-cycle ended",
+                "r = e/e_H",
+                series,
+            )
+        })
+        .collect()
+}
+
+/// Render the page from the `tests` and `impacts` tables.
+pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveError> {
     let (pts, left_out) = points(tests).map_err(|e| ArchiveError::Page(e.to_string()))?;
     let mut page = Page::new("Lab archive — coefficients of restitution of every campaign");
     page.p(&format!(
@@ -101,6 +159,19 @@ pub fn render(tests: &DataFrame) -> Result<String, ArchiveError> {
     ];
     let fig = plots::render(&panels, 900, 380).map_err(|e| ArchiveError::Page(e.to_string()))?;
     page.figure(&fig.svg, "Every archived test's r⁺ and r⁻ with its band (± 2u), by rocking type.");
+    let ipts = impact_points(tests, impacts).map_err(|e| ArchiveError::Page(e.to_string()))?;
+    if ipts.is_empty() {
+        page.p("No archived impact of a test with status ok carries a coefficient (side, e, r): no impact plot.");
+    } else {
+        let fig = plots::render(&impact_panels(&ipts), 900, 380).map_err(|e| ArchiveError::Page(e.to_string()))?;
+        page.figure(
+            &fig.svg,
+            &format!(
+                "r = e/e_H of every archived impact ({} of tests with status ok) against the amplitude of the half-cycle it ends, by campaign: the data a restitution law r(a) is fitted to (docs/restitution-law.md).",
+                ipts.len()
+            ),
+        );
+    }
     let mut by: BTreeMap<(String, String), Vec<&Point>> = BTreeMap::new();
     for p in &pts {
         by.entry((p.campaign.clone(), p.rocking.clone())).or_default().push(p);
@@ -125,8 +196,8 @@ pub fn render(tests: &DataFrame) -> Result<String, ArchiveError> {
 }
 
 /// Write `archive.html` (atomically).
-pub fn write(archive: &Path, tests: &DataFrame) -> Result<(), ArchiveError> {
+pub fn write(archive: &Path, tests: &DataFrame, impacts: &DataFrame) -> Result<(), ArchiveError> {
     let mut files = crate::report::Files::default();
-    files.add("archive.html", render(tests)?);
+    files.add("archive.html", render(tests, impacts)?);
     crate::report::write_files(archive, &files).map_err(|e| ArchiveError::Write(e.to_string()))
 }

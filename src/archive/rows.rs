@@ -38,7 +38,7 @@ pub struct Reduction {
     pub campaign: String,
     pub tests: DataFrame,
     pub impacts: DataFrame,
-    /// Tests whose `impacts` were not in SPEC's shape (no `side`), so not archived.
+    /// Tests none of whose `impacts` is in SPEC's shape (no `side`), so not archived.
     pub impacts_skipped: Vec<String>,
 }
 
@@ -94,7 +94,7 @@ pub fn reduction(doc: &Value, origin: &str) -> Result<Reduction, ArchiveError> {
     })
 }
 
-/// One row per impact of every test whose `impacts` are in SPEC's shape.
+/// One row per impact in SPEC's shape (with its side, e and r) of every test.
 fn impact_rows(tests: &[Value], campaign: &str, sha: &str) -> PolarsResult<(DataFrame, Vec<String>)> {
     let (mut test, mut k, mut side) = (Vec::<String>::new(), Vec::<Option<i64>>::new(), Vec::<Option<String>>::new());
     let mut numbers: Vec<Vec<Option<f64>>> = vec![Vec::new(); IMPACT_NUMBERS.len()];
@@ -104,11 +104,15 @@ fn impact_rows(tests: &[Value], campaign: &str, sha: &str) -> PolarsResult<(Data
         let Some(list) = t.get("impacts").and_then(Value::as_array) else {
             continue;
         };
-        if list.iter().any(|i| i.get("side").is_none()) {
+        // An impact without a coefficient (its next peak not read) has no side, e
+        // or r: not a row. A test none of whose impacts has them is in the
+        // earlier internal shape, and the caller says so.
+        let coefficients: Vec<&Value> = list.iter().filter(|i| i.get("side").and_then(Value::as_str).is_some()).collect();
+        if coefficients.is_empty() && !list.is_empty() {
             skipped.push(id.to_string());
             continue;
         }
-        for i in list {
+        for i in coefficients {
             test.push(id.to_string());
             k.push(i.get("k").and_then(Value::as_i64));
             side.push(i.get("side").and_then(Value::as_str).map(str::to_string));

@@ -119,18 +119,8 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
         None => coefficients_from_args(a, block)?,
     };
     let (e_in, e_out) = (check_e("e_in", e_in)?, check_e("e_out", e_out)?);
-    if a.polarity != 1 && a.polarity != -1 {
-        bail!("--polarity {}: expected 1 or -1", a.polarity);
-    }
-    use rocklab::limits;
-    let flag = |name: &str, v: f64, r: limits::Range| r.check(name, v).map_err(anyhow::Error::msg);
-    flag("--scale", a.scale, limits::MAGNIFICATION)?;
-    flag("--rtol", a.rtol, limits::RTOL)?;
-    flag("--atol", a.atol, limits::ATOL)?;
-    flag("--t-extra", a.t_extra, limits::T_EXTRA_S)?;
     let overturn_limit = a.overturn_limit.or(block.impact.overturn_limit_rad).unwrap_or(block.block.alpha);
-    flag("overturn limit (rad)", overturn_limit, limits::ANGLE_RAD)?;
-    Ok(RunSpec {
+    let spec = RunSpec {
         e_in,
         e_out,
         law: None,
@@ -141,7 +131,13 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
         rtol: a.rtol,
         atol: a.atol,
         keep_history: true,
+    };
+    spec.check(|key| match key {
+        "overturn_limit" => "overturn limit (rad)".into(),
+        k => format!("--{}", k.replace('_', "-")),
     })
+    .map_err(anyhow::Error::msg)?;
+    Ok(spec)
 }
 
 pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {

@@ -95,10 +95,17 @@ impl Files {
 /// The one writer: every file under `dir` (folders created), each atomically
 /// ([`crate::atomic::write_under`]: a temporary sibling, then a rename).
 /// Before the first byte is written, every file is checked ([`check_files`]): a
-/// path that would leave `dir`, two files under one path, or a non-finite number
-/// in a text output refuses the whole set, so a failed run writes nothing.
+/// path that would leave `dir` (by its names or through a folder that is a
+/// symbolic link), two files under one path, or a non-finite number in a text
+/// output refuses the whole set, so a failed run writes nothing.
 pub fn write_files(dir: &Path, files: &Files) -> Result<(), ReportError> {
     check_files(files)?;
+    for (rel, _) in &files.0 {
+        crate::atomic::check_no_link(dir, rel).map_err(|why| ReportError::Path {
+            path: crate::error::excerpt(&rel.to_string_lossy(), 60),
+            why,
+        })?;
+    }
     for (rel, bytes) in &files.0 {
         crate::atomic::write_under(dir, rel, bytes).map_err(|source| ReportError::Write { path: dir.join(rel), source })?;
     }

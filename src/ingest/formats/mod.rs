@@ -141,7 +141,7 @@ pub fn to_log(req: &Request, ch: Channels) -> Result<LogData, InputError> {
                 format!(
                     "{place}row {}: '{name}' is {}: expected a finite measured value",
                     ch.first_row + i,
-                    values[i]
+                    crate::limits::show(values[i])
                 ),
             ));
         }
@@ -154,8 +154,8 @@ pub fn to_log(req: &Request, ch: Channels) -> Result<LogData, InputError> {
                 "{place}row {}: '{}' {} is {what} (previous row {}): expected strictly increasing time",
                 ch.first_row + i,
                 req.time_column,
-                ch.time[i],
-                ch.time[i - 1]
+                crate::limits::show(ch.time[i]),
+                crate::limits::show(ch.time[i - 1])
             ),
         ));
     }

@@ -746,6 +746,23 @@ fn holdout_law_from_readings() {
             v.iter().sum::<f64>() / v.len() as f64
         };
         let cst: Vec<f64> = listed.iter().map(|l| mean(l.2) - l.4).collect();
+        // Where the law misses: inside the amplitudes it was fitted on, and
+        // below them (extrapolated).
+        let (lo, hi) = (law.parameters.amplitude_min, law.parameters.amplitude_max);
+        for (label, keep) in [("inside", true), ("outside", false)] {
+            let part: Vec<f64> = listed
+                .iter()
+                .zip(&err)
+                .filter(|(l, _)| (l.3 >= lo && l.3 <= hi) == keep)
+                .map(|(_, e)| *e)
+                .collect();
+            let mean_err = part.iter().sum::<f64>() / part.len().max(1) as f64;
+            println!(
+                "{name}: {label} a = {lo:.4}–{hi:.4}: {} listed impacts, law RMS {:.4}, mean error {mean_err:+.4}",
+                part.len(),
+                rms(&part)
+            );
+        }
         println!(
             "{name}: law from the readings ({:?}, {:?}) RMS {:.4} over {} listed impacts; best constant pair {:.4}; sides {:?}",
             law.form,

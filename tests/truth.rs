@@ -396,7 +396,11 @@ fn accuracy_table() {
 /// status is ok, and |error| / u of each of its first six peaks (u the stated
 /// standard uncertainty).
 fn holdout_report(name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    engine_report(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name), name)
+}
+
+/// [`holdout_report`] of the campaign in `dir` (truth.json with `peaks`).
+fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let e_h = campaign.e_housner;
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
@@ -440,15 +444,56 @@ fn holdout_report(name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
             errs.join(", "),
             r.analysis.quality.describe()
         );
+        if std::env::var("ENGINE_DETAIL").is_ok() {
+            print_readings(&t.spec.id, r, t.spec.lever_arm_m * 1000.0, &true_v);
+        }
         out.push((t.spec.id.clone(), worst, r.analysis.quality.is_ok(), z));
     }
     out
 }
 
+/// Each of the first six peaks of one test as read locally (smooth extreme,
+/// kink at the crossing) and by the global fit's arc-end re-fit, in % of the
+/// truth (`ENGINE_DETAIL` set).
+fn print_readings(id: &str, r: &rocklab::reduce::Reduced, lever_mm: f64, true_v: &[f64]) {
+    let late = r.analysis.late_peaks(&r.log.time_s, lever_mm, 0, 6);
+    let a = &r.analysis;
+    if let Ok(dir) = std::env::var("ENGINE_CURVE") {
+        let text: String = a.fit_curve.iter().map(|(t, x, v)| format!("{t} {x} {v}\n")).collect();
+        std::fs::write(Path::new(&dir).join(format!("{id}.curve")), text).unwrap();
+    }
+    println!(
+        "    p {:?}, lambda {:?}, gamma {:?}, contact phases {}; speeds after/before each impact {:?}",
+        a.p_fit,
+        a.lambda_fit,
+        a.gamma_fit,
+        a.contact_phases,
+        a.impacts
+            .iter()
+            .map(|i| i.v_after_mm_s.map_or(f64::NAN, |v| (v / i.v_before_mm_s * 1000.0).round() / 1000.0))
+            .collect::<Vec<_>>()
+    );
+    for (k, &vt) in true_v.iter().take(6).enumerate() {
+        let pc = |v: f64, u: f64| format!("{:+.1}%±{:.1}", 100.0 * (v / vt - 1.0), 100.0 * u / vt.abs());
+        let p = late.iter().find(|p| p.k == k);
+        let smooth = p.and_then(|p| p.smooth).map_or("-".into(), |x| pc(x.velocity_mm_s, x.u_mm_s));
+        let kink = p.and_then(|p| p.kink).map_or("-".into(), |x| pc(x.velocity_mm_s, x.u_mm_s));
+        let arc = r.analysis.local_peaks.get(k).copied().flatten().map_or("-".into(), |(v, u)| pc(v, u));
+        let g = &r.analysis.peaks[k];
+        println!(
+            "    k{k}: global {}  smooth {smooth}  kink {kink}  arc-end {arc}",
+            pc(g.velocity_mm_s, g.velocity_u_mm_s.unwrap_or(0.0))
+        );
+    }
+}
+
 /// (tests flagged, worst value of the ok tests in pp, share of the ok tests'
 /// peaks within 2 stated u).
 fn holdout_summary(name: &str) -> (usize, f64, f64) {
-    let rep = holdout_report(name);
+    summary_of(name, &holdout_report(name))
+}
+
+fn summary_of(name: &str, rep: &[(String, f64, bool, Vec<f64>)]) -> (usize, f64, f64) {
     let flagged = rep.iter().filter(|r| !r.2).count();
     let worst_ok = rep.iter().filter(|r| r.2).map(|r| r.1).fold(0.0, f64::max);
     let z: Vec<f64> = rep.iter().filter(|r| r.2).flat_map(|r| r.3.clone()).collect();
@@ -463,18 +508,23 @@ fn holdout_summary(name: &str) -> (usize, f64, f64) {
 /// Issue 18: walls the estimator was not tuned on, made with MuJoCo by
 /// `tools/mujoco_campaign.py` (a slenderer wall on a stiff bedding with lossy
 /// transverse walls, one-sided, 100–1000 Hz; a squatter wall on a soft bedding,
-/// two-sided). Measured when this was written: two-sided, 2 of 5 tests flagged
-/// (H2_110_2: the residuals around impact 4; H2_70_1: its late contacts), the ok
-/// ones within 0.58 pp; one-sided, 1 of 6 flagged, the ok ones within 1.24 pp
-/// (the inward half-cycles' peaks 2–3.5 % low: the global fit's lossy-restraint
-/// arc against MuJoCo's restraint); 100 % (two-sided) and 97 % (one-sided) of the ok tests' peaks
-/// within 2 u. This test guards what holds (no ok test of the two-sided
-/// campaign beyond the issue's 1.0 pp, the coverage of u, at most one one-sided
-/// test flagged); `holdouts_meet_the_issue` is the issue's full criterion,
-/// not met yet.
+/// two-sided). Measured when this was written (docs/accuracy.md): two-sided,
+/// 1 of 5 tests flagged (H2_70_1, 7.75 pp off: the residuals around impact 3,
+/// its peak 5 read 61.8 % fast by the global fit and 10.1 % slow locally), the
+/// ok ones within 0.58 pp (H2_110_2's residuals around impact 4 are vouched
+/// for by its local readings, `src/peaks/vouch.rs`); one-sided, 0 of 6
+/// flagged, the ok ones within 1.66 pp (the outward peaks v₁, v₃ 2–3.7 % low:
+/// the global fit's lossy-restraint arc against MuJoCo's restraint); 100 %
+/// (two-sided) and 94 % (one-sided) of the ok tests' peaks within 2 stated u.
+/// This test guards what holds (the two-sided campaign meets the issue's
+/// criterion: at most one test flagged, no ok test beyond 1.0 pp, ≥ 90 % of
+/// the peaks within 2 u; one-sided, at most one flagged and the coverage of
+/// u); `holdouts_meet_the_issue` is the issue's full criterion, not met yet
+/// one-sided.
 #[test]
 fn mujoco_holdouts_reduced_or_flagged() {
-    let (_, worst2, within2) = holdout_summary("mujoco-holdout-two-sided");
+    let (flagged2, worst2, within2) = holdout_summary("mujoco-holdout-two-sided");
+    assert!(flagged2 <= 1, "two-sided: {flagged2} tests flagged");
     assert!(worst2 <= 1.0, "two-sided: an ok test {worst2:.2} pp off");
     assert!(within2 >= 0.9, "two-sided: {within2:.2} of the peaks within 2 u");
     let (flagged1, _, within1) = holdout_summary("mujoco-holdout-one-sided");
@@ -484,15 +534,34 @@ fn mujoco_holdouts_reduced_or_flagged() {
 
 /// The issue's criterion on both hold-out campaigns: at most one test flagged
 /// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
-/// within 2 u. Fails today (see `mujoco_holdouts_reduced_or_flagged`).
+/// within 2 u. Fails today on the one-sided campaign (see
+/// `mujoco_holdouts_reduced_or_flagged`).
 #[test]
-#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.24 pp, two-sided 2 flagged"]
+#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.66 pp"]
 fn holdouts_meet_the_issue() {
-    for name in ["mujoco-holdout-one-sided", "mujoco-holdout-two-sided"] {
+    for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
         let (flagged, worst, within) = holdout_summary(name);
         assert!(
             flagged <= 1 && worst <= 1.0 && within >= 0.9,
             "{name}: {flagged} flagged, {worst:.2} pp, {within:.2} within 2 u"
         );
+    }
+}
+
+/// Issue 18 on engine-made campaigns outside the repository (the fresh walls
+/// of `tools/mujoco_campaign.py --preset fresh-one-sided|fresh-two-sided`,
+/// never tuned on): the hold-outs' report and summary for each directory of
+/// `ENGINE_CAMPAIGNS` (colon-separated). Printed only.
+/// `ENGINE_CAMPAIGNS=/tmp/a:/tmp/b cargo test --release --test truth engine_campaigns -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement on campaigns outside the repository, printed (docs/accuracy.md)"]
+fn engine_campaigns() {
+    let Ok(dirs) = std::env::var("ENGINE_CAMPAIGNS") else {
+        println!("ENGINE_CAMPAIGNS is not set: nothing measured");
+        return;
+    };
+    for dir in dirs.split(':') {
+        let rep = engine_report(Path::new(dir), dir);
+        summary_of(dir, &rep);
     }
 }

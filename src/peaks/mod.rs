@@ -59,7 +59,8 @@
 //! reads L sin θ: 0.1 mm on a 150 mm release), and the impacts are located roughly
 //! by zero crossings with hysteresis (`prepare.rs`, `crossings.rs`). After it:
 //! the plausibility checks of [`checks`] (a test that trips one is
-//! [`Quality::Suspect`]) and the covariance of the peaks with its model-form
+//! [`Quality::Suspect`]; residuals that stand out around an impact only where
+//! local readings of the peaks do not vouch for them, `vouch.rs`) and the covariance of the peaks with its model-form
 //! terms (`uncertainty.rs`).
 //!
 //! Assumptions: free vibration (no base motion), the release from rest on the
@@ -86,6 +87,7 @@ mod quality;
 pub mod restraint;
 mod segments;
 mod uncertainty;
+mod vouch;
 
 use crate::signal::savgol::SavGol;
 use crate::signal::{median, noise_sigma};
@@ -486,7 +488,24 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Per impact: the local reading where the log resolves a smooth extreme.
     let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma);
+    let late = || {
+        late::read_late(
+            &late::LateInput {
+                t,
+                x: &p.x,
+                lever_mm: phys.lever_arm_mm,
+                sigma: p.sigma,
+                dt: p.dt,
+                release_s: fit.model().release_time(),
+                crossings: &p.crossings,
+            },
+            0,
+        )
+        .into_iter()
+        .take(n_peaks)
+        .collect()
+    };
+    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),

@@ -1,8 +1,9 @@
 //! The second estimate of each peak and the plausibility checks of one
 //! analysis ([`super::checks`]).
 
+use super::late::LatePeak;
 use super::segments::SegmentFit;
-use super::{checks, Peak, Quality, ReadingMethod};
+use super::{checks, vouch, Peak, Quality, ReadingMethod};
 
 /// The second estimate of each peak: the end of free arc k re-fitted from its own
 /// samples (the later half of the arc, at least 4 samples) by [`checks::local_slope`].
@@ -35,6 +36,11 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 /// global fit's contact phase at impact k nor on where its zero lies: the checks
 /// of that contact (its length, its overshoot, its zero readings, the residuals
 /// around it, the re-fit of the arc's end) are not run for it.
+///
+/// Residuals that stand out around an impact are a reason only where the
+/// local readings of the peaks (`late`, computed only then) do not vouch for
+/// the global fit's ([`vouch`]).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn plausibility(
     fit: &SegmentFit,
     peaks: &[Peak],
@@ -43,6 +49,7 @@ pub(super) fn plausibility(
     methods: &[ReadingMethod],
     dt: f64,
     sigma: f64,
+    late: &dyn Fn() -> Vec<LatePeak>,
 ) -> Quality {
     let is_local = |k: usize| methods.get(k) == Some(&ReadingMethod::LocalExtreme);
     let local: Vec<Option<(f64, f64)>> = local.iter().enumerate().map(|(k, l)| if is_local(k) { None } else { *l }).collect();
@@ -66,7 +73,7 @@ pub(super) fn plausibility(
         checks::energy_gain(&v, &u),
         checks::impact_gains_speed(&v, &after, &u),
         checks::misfit(&resid, sigma),
-        checks::structured_near_impacts(&fit.tw, &resid, &onsets, dt, sigma),
+        structured_unvouched(fit, &resid, &onsets, peaks, dt, sigma, late),
         checks::disagreement(&v_onset, &u, &local),
         m.contact_windows().and_then(|windows| {
             let windows: Vec<(f64, f64)> = windows
@@ -92,4 +99,25 @@ pub(super) fn plausibility(
     } else {
         Quality::Suspect(reasons)
     }
+}
+
+/// [`checks::structured_near_impacts`], unless the local readings vouch for the
+/// peaks ([`vouch`]).
+fn structured_unvouched(
+    fit: &SegmentFit,
+    resid: &[f64],
+    onsets: &[f64],
+    peaks: &[Peak],
+    dt: f64,
+    sigma: f64,
+    late: &dyn Fn() -> Vec<LatePeak>,
+) -> Option<String> {
+    let flagged: Vec<usize> = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma)
+        .iter()
+        .map(|f| f.0)
+        .collect();
+    if flagged.is_empty() || vouch::vouched(peaks, &late(), &flagged) {
+        return None;
+    }
+    checks::structured_near_impacts(&fit.tw, resid, onsets, dt, sigma)
 }

@@ -488,7 +488,11 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Per impact: the local reading where the log resolves a smooth extreme.
     let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
     let local = quality::local_peaks(&fit, n_peaks, p.sigma);
+    // One-sided walls: no local reading vouches (vouch.rs, "Not on one-sided walls").
     let late = || {
+        if phys.rocking == Rocking::OneSided {
+            return Vec::new();
+        }
         late::read_late(
             &late::LateInput {
                 t,

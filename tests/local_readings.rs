@@ -232,7 +232,7 @@ fn every_impact_in(dir: &std::path::Path) -> EveryImpact {
 /// Asserted where it is met (the public two-sided campaign: every listed
 /// impact, RMS 0.0125 when written) and the RMS of the two-sided hold-out's
 /// reported impacts (0.0123, 49 % of them, when written); the one-sided
-/// campaigns are printed (100 % at 0.0249 / 79 % at 0.0242 with the contact
+/// campaigns are printed (100 % at 0.0249 / 68 % at 0.0216 with the contact
 /// model: docs/restitution-law.md). Minutes in a debug build:
 /// `cargo test --release --test local_readings every_impact -- --include-ignored --nocapture`.
 #[test]

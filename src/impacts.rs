@@ -16,7 +16,7 @@
 //! (negative) correlation, and the fully correlated model-form terms of the peaks
 //! ([`crate::peaks`]) carry theirs. The law's fit ([`crate::law_fit`]) uses Σ_r.
 
-use crate::peaks::late::{LatePeak, Reading};
+use crate::peaks::late::{ContactPeak, LatePeak, Reading};
 use crate::peaks::{Analysis, Impact, ReadingMethod};
 use crate::wall::Side;
 
@@ -125,7 +125,8 @@ pub const MAX_LATE_R_U: f64 = 0.05;
 /// at the first impact with no such pair, with e > 1, or with u(r) above
 /// [`MAX_LATE_R_U`]. Each r's uncertainty is propagated from its two readings'
 /// (independent local fits); consecutive impacts that use the same reading of
-/// their shared peak carry its negative correlation.
+/// their shared peak carry its negative correlation. The reduction uses this on
+/// two-sided walls, and [`extend_late_contacts`] on one-sided ones.
 pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &Geometry, two_sided: bool) {
     if late.first().map(|p| p.k) != Some(table.impacts.len()) {
         return;
@@ -140,31 +141,67 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
         let Some((a, b)) = methods.iter().find_map(|&m| Some((w[0].by(m)?, w[1].by(m)?))) else {
             break;
         };
-        let e = (b.velocity_mm_s / a.velocity_mm_s).abs();
-        let r = e / e_h;
-        let r_u = r * ((a.u_mm_s / a.velocity_mm_s).powi(2) + (b.u_mm_s / b.velocity_mm_s).powi(2)).sqrt();
-        if e > 1.0 || !r_u.is_finite() || r_u > MAX_LATE_R_U {
+        let Some(coefficient) = late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo) else {
             break;
-        }
-        let k = w[0].k;
-        let coefficient = ImpactCoefficient {
-            k,
-            side: if k % 2 == 0 { Side::Inward } else { Side::Outward },
-            amplitude_over_alpha: (w[0].apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / geo.alpha_rad,
-            speed_before_mm_s: a.velocity_mm_s.abs(),
-            speed_after_mm_s: b.velocity_mm_s.abs(),
-            e,
-            e_u: Some(r_u * e_h),
-            r,
-            r_u: Some(r_u),
         };
         added.push((coefficient, a, b));
     }
-    append_late(table, &added, late);
+    let crossings: Vec<f64> = late.iter().map(|p| p.crossing_s).collect();
+    append_late(table, &added, &crossings);
 }
 
-/// Appends the late impacts, their covariance block and their raw impacts.
-fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], late: &[LatePeak]) {
+/// One-sided walls: the impacts after the table's from the contact model's
+/// readings ([`crate::peaks::late::contact_peaks`]: each half-cycle's own free
+/// motion, the free arc on the base or the push into the lossy transverse
+/// walls, plus the contact's force from its onset). Impact k is reported where
+/// peaks k and k + 1 both have a contact reading whose model fits the samples to
+/// the noise; the list stops at the first impact without, with e > 1, or with
+/// u(r) above [`MAX_LATE_R_U`]. Uncertainties and correlations as
+/// [`extend_late`]'s.
+pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry) {
+    let Some(i0) = peaks.iter().position(|p| p.k == table.impacts.len()) else {
+        return;
+    };
+    let peaks = &peaks[i0..];
+    let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
+    for w in peaks.windows(2) {
+        let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
+        let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else { break };
+        let Some(c) = late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo) else {
+            break;
+        };
+        added.push((c, a, b));
+    }
+    let crossings: Vec<f64> = peaks.iter().map(|p| p.crossing_s).collect();
+    append_late(table, &added, &crossings);
+}
+
+/// Impact k's coefficient from the readings `a` and `b` of peaks k and k + 1,
+/// None where e > 1 or u(r) is above [`MAX_LATE_R_U`] or not finite.
+fn late_coefficient(k: usize, apex_mm: f64, a: Reading, b: Reading, e_h: f64, geo: &Geometry) -> Option<ImpactCoefficient> {
+    let e = (b.velocity_mm_s / a.velocity_mm_s).abs();
+    let r = e / e_h;
+    let r_u = r * ((a.u_mm_s / a.velocity_mm_s).powi(2) + (b.u_mm_s / b.velocity_mm_s).powi(2)).sqrt();
+    if e > 1.0 || !r_u.is_finite() || r_u > MAX_LATE_R_U {
+        return None;
+    }
+    Some(ImpactCoefficient {
+        k,
+        side: if k.is_multiple_of(2) { Side::Inward } else { Side::Outward },
+        amplitude_over_alpha: (apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / geo.alpha_rad,
+        speed_before_mm_s: a.velocity_mm_s.abs(),
+        speed_after_mm_s: b.velocity_mm_s.abs(),
+        e,
+        e_u: Some(r_u * e_h),
+        r,
+        r_u: Some(r_u),
+    })
+}
+
+/// Appends the late impacts, their covariance block and their raw impacts;
+/// `crossings[i]` ends the half-cycle of the i-th added impact (one more for
+/// the last one's next peak).
+fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], crossings: &[f64]) {
     if added.is_empty() {
         return;
     }
@@ -192,7 +229,7 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
     for (i, (c, a, b)) in added.iter().enumerate() {
         table.raw.push(Impact {
             k: c.k,
-            time_s: late[i].crossing_s,
+            time_s: crossings[i],
             entering: c.side,
             v_before_mm_s: a.velocity_mm_s,
             v_after_mm_s: Some(b.velocity_mm_s),
@@ -202,7 +239,7 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
         let next = c.k + 1;
         table.raw.push(Impact {
             k: next,
-            time_s: late[added.len()].crossing_s,
+            time_s: crossings[added.len()],
             entering: if next % 2 == 0 { Side::Inward } else { Side::Outward },
             v_before_mm_s: b.velocity_mm_s,
             v_after_mm_s: None,
@@ -339,5 +376,72 @@ mod tests {
         let cov: Vec<Vec<f64>> = (0..3).map(|i| (0..3).map(|j| 1e-4 * v[i] * v[j]).collect()).collect();
         let c = ratio_covariance(&v, &cov, 1.0);
         assert!(c.iter().flatten().all(|x| x.abs() < 1e-18), "{c:?}");
+    }
+
+    fn contact(k: usize, v: f64, fits: bool) -> ContactPeak {
+        use crate::peaks::late::ContactReading;
+        ContactPeak {
+            k,
+            crossing_s: k as f64 + 0.1,
+            apex_mm: 10.0,
+            reading: Some(ContactReading {
+                reading: Reading {
+                    time_s: k as f64,
+                    velocity_mm_s: v,
+                    u_mm_s: 0.01 * v.abs(),
+                },
+                chi2: if fits { 20.0 } else { 200.0 },
+                n: 25,
+            }),
+        }
+    }
+
+    /// [`extend_late_contacts`]: the late list starts at the table's last peak,
+    /// pairs contact readings that fit the samples to the noise, and stops at
+    /// the first that does not.
+    #[test]
+    fn late_contacts_pair_readings_that_fit() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 1000.0,
+            alpha_rad: 0.1,
+        };
+        let peaks = [
+            contact(1, 90.0, true),
+            contact(2, -80.0, true),
+            contact(3, 70.0, true),
+            contact(4, -60.0, false),
+            contact(5, 50.0, true),
+        ];
+        let mut table = ImpactTable {
+            impacts: vec![impact_stub(0)],
+            r_cov: Some(vec![vec![1e-4]]),
+            raw: Vec::new(),
+        };
+        table.impacts.push(impact_stub(1));
+        table.r_cov = Some(vec![vec![1e-4, 0.0], vec![0.0, 1e-4]]);
+        extend_late_contacts(&mut table, &peaks, 1.0, &geo);
+        let ks: Vec<usize> = table.impacts.iter().map(|i| i.k).collect();
+        assert_eq!(ks, [0, 1, 2], "impact 2 from peaks 2 and 3; peak 4 does not fit");
+        assert!((table.impacts[2].r - 70.0 / 80.0).abs() < 1e-12);
+        assert_eq!(table.impacts[2].side, Side::Inward);
+        // Starting past the table: nothing added.
+        let mut short = ImpactTable::default();
+        extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo);
+        assert!(short.impacts.is_empty());
+    }
+
+    fn impact_stub(k: usize) -> ImpactCoefficient {
+        ImpactCoefficient {
+            k,
+            side: if k.is_multiple_of(2) { Side::Inward } else { Side::Outward },
+            amplitude_over_alpha: 0.1,
+            speed_before_mm_s: 100.0,
+            speed_after_mm_s: 90.0,
+            e: 0.9,
+            e_u: Some(0.01),
+            r: 0.9,
+            r_u: Some(0.01),
+        }
     }
 }

@@ -3,7 +3,8 @@
 //! and their uncertainties. The log arrives already read ([`crate::ingest`] reads
 //! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
 
-use crate::impacts::{extend_late, impact_table, Geometry, ImpactTable};
+use crate::impacts::{extend_late, extend_late_contacts, impact_table, Geometry, ImpactTable};
+use crate::peaks::late::{contact_peaks, CONTACT_POST_S};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
 use crate::restitution::{coefficients, uncertainties, Coefficients};
 use crate::wall::{Rocking, Wall};
@@ -89,7 +90,9 @@ pub const MAX_IMPACT_PEAKS: usize = 12;
 /// Every impact the log resolves: the table's analysis gives the impacts
 /// between its peaks (n − 1 of them), and the later ones come from the peaks
 /// after it, each read from the samples around it
-/// ([`crate::peaks::late`], [`crate::impacts::extend_late`]), up to
+/// ([`crate::peaks::late`], [`crate::impacts::extend_late`]; one-sided walls
+/// with the contact model, [`crate::peaks::late::contact_peaks`],
+/// [`crate::impacts::extend_late_contacts`]), up to
 /// [`MAX_IMPACT_PEAKS`]. Only the default estimator's ok tests are extended (a
 /// suspect test keeps its own analysis' impacts; the Savitzky–Golay estimator
 /// its own peaks).
@@ -102,9 +105,20 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
     let mut table = impact_table(&red.analysis, &geo, e_housner);
     let n = red.analysis.peaks.len();
     if options.method == crate::peaks::Method::Segments && red.analysis.quality.is_ok() && n >= 2 {
-        let late = red.analysis.late_peaks(&red.log.time_s, phys.lever_arm_mm, n - 1, MAX_IMPACT_PEAKS);
-        let two_sided = phys.rocking == crate::wall::Rocking::TwoSided;
-        extend_late(&mut table, &late, e_housner, &geo, two_sided);
+        if phys.rocking == crate::wall::Rocking::TwoSided {
+            let late = red.analysis.late_peaks(&red.log.time_s, phys.lever_arm_mm, n - 1, MAX_IMPACT_PEAKS);
+            extend_late(&mut table, &late, e_housner, &geo, true);
+        } else {
+            let contacts = contact_peaks(
+                &red.analysis,
+                &red.log.time_s,
+                phys.lever_arm_mm,
+                phys.p_guess,
+                MAX_IMPACT_PEAKS,
+                CONTACT_POST_S,
+            );
+            extend_late_contacts(&mut table, &contacts, e_housner, &geo);
+        }
     }
     red.impact_peaks = table.impacts.len() + 1;
     red.impacts = table;

@@ -44,8 +44,17 @@
 //! tall (noise-level motion: no impact to read), or whose speed exceeds the
 //! previous peak's (free rocking only loses speed).
 //!
+//! # One-sided walls
+//! Neither reading suits a one-sided wall's late peaks: its half-cycles end in
+//! contacts of 7–55 ms whose velocity turns a few ms before θ = 0, and at the
+//! end of the push into the transverse walls the kink's cubic overshoots
+//! (+0.056 on average on the public MuJoCo campaign). [`read_contact`] reads
+//! them with a model of the half-cycle's free motion and of the contact's force
+//! ([`FreeMotion`], docs/restitution-law.md).
+//!
 //! No crate does this: ordinary least squares (nalgebra) on windows chosen by
-//! the data, as in [`super::local`].
+//! the data, as in [`super::local`], over grids of the contact's onset and of
+//! the restraint's (λ, ω).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -253,6 +262,298 @@ fn read_one(inp: &LateInput, y: &[f64], k: usize, start: f64, end_next: f64, wan
     })
 }
 
+/// # One-sided walls: a model of the contact (issue 20)
+///
+/// On a one-sided wall the two half-cycles are different motions, and neither
+/// ends in an impact sharper than the samples: the truth's peak is the extreme
+/// of the sensor's velocity, a few ms before θ = 0, where the bedding's force
+/// has grown enough to turn the wall. [`read_contact`] fits the samples of the
+/// half-cycle (from a quarter of it, past the previous contact, to `post` after
+/// the crossing) with the half-cycle's own free motion plus the contact's force
+/// from its onset τ_on, and reads the extreme of the fitted velocity before the
+/// crossing (τ = t − c_k, s = (τ − τ_on)₊/h, h = 10 ms):
+///
+///   y(τ) = f(τ) + j₂ s² + j₃ s³,
+///
+/// - the free arc on the base (outward half-cycle, paper Eq. 1 near θ = α's
+///   opposite side: θ'' = p² (θ − θ_c)): f spans {1, cosh pτ, sinh pτ}, with p the
+///   wall's rocking rate;
+/// - the push into the transverse walls (inward half-cycle, a lossy spring
+///   contact): θ'' = −ω² (θ − θ_e) − 2λ θ', f spans {1, e^{−λτ} cos ωτ,
+///   e^{−λτ} sin ωτ}, (λ, ω) one pair per test ([`restraint_of`]);
+/// - the contact: a force that sets in at τ_on and grows (s², s³: the
+///   acceleration jumps and ramps), τ_on the best χ² over a grid of 0.5 ms.
+///
+/// Its u: the fit's σ² dᵀ(XᵀX)⁻¹d at the extreme, and the spread of the readings
+/// over the onsets whose χ² is within 1 of the best (d²/3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FreeMotion {
+    /// The free arc on the base, θ'' = p²(θ − θ_c): p in rad/s.
+    Arc { p: f64 },
+    /// The lossy restraint: θ'' = −ω²(θ − θ_e) − 2λθ', λ and ω in 1/s.
+    Restraint { lambda: f64, omega: f64 },
+}
+
+/// Time scale of the contact's columns (s).
+const CONTACT_SCALE_S: f64 = 0.01;
+
+impl FreeMotion {
+    /// The free motion's three columns and their time derivatives at τ (s).
+    fn columns(&self, tau: f64) -> ([f64; 3], [f64; 3]) {
+        let h = CONTACT_SCALE_S;
+        match *self {
+            // {1, 2(cosh pτ − 1)/(ph)², sinh pτ/(ph)} spans the arc and stays
+            // well conditioned where pτ is small (≈ {1, (τ/h)², τ/h}).
+            FreeMotion::Arc { p } => {
+                let (c, sh) = ((p * tau).cosh(), (p * tau).sinh());
+                let q = p * h;
+                ([1.0, 2.0 * (c - 1.0) / (q * q), sh / q], [0.0, 2.0 * p * sh / (q * q), p * c / q])
+            }
+            FreeMotion::Restraint { lambda, omega } => {
+                let e = (-lambda * tau).exp();
+                let (c, s) = ((omega * tau).cos(), (omega * tau).sin());
+                ([1.0, e * c, e * s], [0.0, e * (-lambda * c - omega * s), e * (-lambda * s + omega * c)])
+            }
+        }
+    }
+}
+
+/// A contact reading: the peak (mm/s) and its u, its time (s), and the fit's
+/// χ² and number of samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactReading {
+    pub reading: Reading,
+    pub chi2: f64,
+    pub n: usize,
+}
+
+impl ContactReading {
+    /// Whether the model fits the samples to the noise: χ² ≤ ν + 3√(2ν).
+    pub fn fits_noise(&self) -> bool {
+        let nu = self.n.saturating_sub(CONTACT_COLUMNS) as f64;
+        nu > 0.0 && self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+    }
+}
+
+const CONTACT_COLUMNS: usize = 5;
+
+/// One fit of [`read_contact`]'s model with the onset at τ_on.
+struct ContactFit {
+    shape: ContactShape,
+    c: DVector<f64>,
+    inv: DMatrix<f64>,
+    chi2: f64,
+    tau_on: f64,
+}
+
+/// The contact's force from its onset: `Jump` (s², s³: the acceleration jumps
+/// and ramps) or `Ramp` (s³, s⁴: a force growing from zero, as a Hertz
+/// contact's; the model-form term of the reading's u).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ContactShape {
+    Jump,
+    Ramp,
+}
+
+fn contact_row(m: FreeMotion, shape: ContactShape, tau: f64, tau_on: f64) -> ([f64; CONTACT_COLUMNS], [f64; CONTACT_COLUMNS]) {
+    let h = CONTACT_SCALE_S;
+    let (f, df) = m.columns(tau);
+    let s = (tau - tau_on).max(0.0) / h;
+    let q = if shape == ContactShape::Ramp { 1 } else { 0 };
+    let (a, b) = (2 + q, 3 + q);
+    (
+        [f[0], f[1], f[2], s.powi(a), s.powi(b)],
+        [df[0], df[1], df[2], a as f64 * s.powi(a - 1) / h, b as f64 * s.powi(b - 1) / h],
+    )
+}
+
+fn contact_fit(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, tau_on: f64, sigma: f64) -> Option<ContactFit> {
+    let n = tau.len();
+    let x = DMatrix::from_fn(n, CONTACT_COLUMNS, |i, j| contact_row(m, shape, tau[i], tau_on).0[j]);
+    let yv = DVector::from_column_slice(y);
+    let inv = x.tr_mul(&x).try_inverse()?;
+    let c = &inv * x.tr_mul(&yv);
+    let chi2 = (&yv - &x * &c).norm_squared() / (sigma * sigma);
+    chi2.is_finite().then_some(ContactFit { shape, c, inv, chi2, tau_on })
+}
+
+impl ContactFit {
+    /// The extreme of want · y' over [τ₀, 0] (400 steps): (τ, y', d).
+    fn extreme(&self, m: FreeMotion, tau0: f64, want: f64) -> (f64, f64, DVector<f64>) {
+        let at = |tau: f64| {
+            let d = DVector::from_row_slice(&contact_row(m, self.shape, tau, self.tau_on).1);
+            (d.dot(&self.c), d)
+        };
+        let mut best = (tau0, f64::NEG_INFINITY, DVector::zeros(CONTACT_COLUMNS));
+        for i in 0..=400 {
+            let tau = tau0 * (1.0 - i as f64 / 400.0);
+            let (v, d) = at(tau);
+            if want * v > best.1 {
+                best = (tau, want * v, d);
+            }
+        }
+        (best.0, want * best.1, best.2)
+    }
+}
+
+/// The samples of half-cycle [start, zero] from a quarter of it on, to `post_s`
+/// after the crossing: (τ = t − zero, y).
+fn contact_window(t: &[f64], y: &[f64], start: f64, zero: f64, post_s: f64) -> (Vec<f64>, Vec<f64>) {
+    let from = start + 0.25 * (zero - start);
+    let (i0, i1) = (t.partition_point(|&v| v <= from), t.partition_point(|&v| v <= zero + post_s));
+    (t[i0..i1].iter().map(|&v| v - zero).collect(), y[i0..i1].to_vec())
+}
+
+/// Every onset's fit, every 0.5 ms from two samples into the window to the crossing.
+fn contact_fits(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigma: f64) -> Vec<ContactFit> {
+    if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
+        return Vec::new();
+    }
+    let first = tau[2.min(tau.len() - 1)].min(0.0);
+    let steps = (-first / 5e-4).floor() as usize;
+    (0..=steps)
+        .filter_map(|i| contact_fit(tau, y, m, shape, -(i as f64) * 5e-4, sigma))
+        .collect()
+}
+
+/// The velocity peak of half-cycle [start, zero] read with the contact model
+/// (see [`FreeMotion`]) on the samples up to `post_s` after the crossing;
+/// `want` is its sign. Its u adds to the fit's and the onset's terms the
+/// window's, d_w²/3, d_w the change of the reading with the window ending two
+/// thirds as far after the crossing (GUM 4.3.7, as [`read_kink`]). None where a
+/// window holds fewer than 10 samples. And the shape's term d_s²/3, d_s the
+/// change of the reading with a force growing from zero (s³, s⁴), as a Hertz
+/// contact's, in place of s², s³: on a Hertz contact the readings were within
+/// 0.7 % and the fit's terms alone missed that by up to 7 u (unit test).
+#[allow(clippy::too_many_arguments)]
+pub fn read_contact(t: &[f64], y: &[f64], start: f64, zero: f64, post_s: f64, m: FreeMotion, sigma: f64, want: f64) -> Option<ContactReading> {
+    let main = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Jump, sigma, want)?;
+    let shorter = read_contact_on(t, y, start, zero, post_s * 2.0 / 3.0, m, ContactShape::Jump, sigma, want)?;
+    let ramp = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Ramp, sigma, want)?;
+    let d_w = shorter.reading.velocity_mm_s - main.reading.velocity_mm_s;
+    let d_s = ramp.reading.velocity_mm_s - main.reading.velocity_mm_s;
+    let mut out = main;
+    out.reading.u_mm_s = (main.reading.u_mm_s.powi(2) + (d_w * d_w + d_s * d_s) / 3.0).sqrt();
+    Some(out)
+}
+
+/// [`read_contact`] on one window, without the window's term.
+#[allow(clippy::too_many_arguments)]
+fn read_contact_on(
+    t: &[f64],
+    y: &[f64],
+    start: f64,
+    zero: f64,
+    post_s: f64,
+    m: FreeMotion,
+    shape: ContactShape,
+    sigma: f64,
+    want: f64,
+) -> Option<ContactReading> {
+    let (tau, yw) = contact_window(t, y, start, zero, post_s);
+    let fits = contact_fits(&tau, &yw, m, shape, sigma);
+    let best = fits.iter().min_by(|a, b| a.chi2.total_cmp(&b.chi2))?;
+    let (tau_pk, v, d) = best.extreme(m, tau[0], want);
+    let spread = fits
+        .iter()
+        .filter(|f| f.chi2 <= best.chi2 + 1.0)
+        .map(|f| (f.extreme(m, tau[0], want).1 - v).abs())
+        .fold(0.0, f64::max);
+    let u_fit2 = (sigma * sigma * (d.transpose() * &best.inv * &d)[(0, 0)]).max(0.0);
+    Some(ContactReading {
+        reading: Reading {
+            time_s: zero + tau_pk,
+            velocity_mm_s: v,
+            u_mm_s: (u_fit2 + spread * spread / 3.0).sqrt(),
+        },
+        chi2: best.chi2,
+        n: tau.len(),
+    })
+}
+
+/// The restraint's (λ, ω) of a test: the pair that minimises the summed best χ²
+/// of [`read_contact`]'s model over the inward half-cycles `halves` (start,
+/// crossing). Grid: ω over ½ … 2 × π / (the median half-cycle's length), 25
+/// log steps; λ = ζω, ζ = 0 … 0.5 by 0.05. None without an inward half-cycle.
+pub fn restraint_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma: f64) -> Option<(f64, f64)> {
+    let windows: Vec<(Vec<f64>, Vec<f64>)> = halves.iter().map(|&(a, b)| contact_window(t, y, a, b, post_s)).collect();
+    let mut lengths: Vec<f64> = halves.iter().map(|&(a, b)| b - a).collect();
+    lengths.sort_by(f64::total_cmp);
+    let omega0 = std::f64::consts::PI / *lengths.get(lengths.len() / 2)?;
+    let mut best: Option<(f64, (f64, f64))> = None;
+    for i in 0..25 {
+        let omega = omega0 * 2f64.powf(-1.0 + 2.0 * i as f64 / 24.0);
+        for j in 0..=10 {
+            let m = FreeMotion::Restraint {
+                lambda: 0.05 * j as f64 * omega,
+                omega,
+            };
+            let total: f64 = windows
+                .iter()
+                .filter_map(|(tau, y)| {
+                    contact_fits(tau, y, m, ContactShape::Jump, sigma)
+                        .iter()
+                        .map(|f| f.chi2)
+                        .min_by(f64::total_cmp)
+                })
+                .sum();
+            if best.is_none_or(|b| total < b.0) {
+                best = Some((total, (0.05 * j as f64 * omega, omega)));
+            }
+        }
+    }
+    best.map(|b| b.1)
+}
+
+/// A peak of a one-sided log read with the contact model ([`contact_peaks`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPeak {
+    pub k: usize,
+    /// The rest-line crossing that ends half-cycle k (impact k), s.
+    pub crossing_s: f64,
+    /// Apex |x| (mm) of half-cycle k.
+    pub apex_mm: f64,
+    pub reading: Option<ContactReading>,
+}
+
+/// How far after the crossing the contact model's window reaches (s): past the
+/// velocity's turn (2–5 ms before θ = 0 on the MuJoCo beddings) far enough to
+/// place the onset and the force's growth; the window's term of the reading's u
+/// says how much the choice moves it (docs/restitution-law.md).
+pub const CONTACT_POST_S: f64 = 0.02;
+
+/// Peaks 1 … `max_peaks − 1` of a one-sided log read with the contact model:
+/// k even ends a free arc on the base (rate `p`), k odd a push into the
+/// transverse walls (the test's restraint, [`restraint_of`]).
+pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, p: f64, max_peaks: usize, post_s: f64) -> Vec<ContactPeak> {
+    if t.len() < 3 || t.len() != a.displacement_mm.len() {
+        return Vec::new();
+    }
+    let departure = t.partition_point(|&v| v < a.release_time_s).min(t.len() - 1);
+    let c = super::crossings::find_crossings(t, &a.displacement_mm, 0.0, a.noise_mm, departure, max_peaks);
+    let x = &a.displacement_mm;
+    let y: Vec<f64> = x.iter().map(|&v| lever_mm * (v / lever_mm).clamp(-1.0, 1.0).asin()).collect();
+    let inward: Vec<(f64, f64)> = (1..c.len()).filter(|k| k % 2 == 1).map(|k| (c[k - 1], c[k])).collect();
+    let restraint = restraint_of(t, &y, &inward, post_s, a.noise_mm);
+    (1..c.len())
+        .map(|k| {
+            let want = if k % 2 == 0 { -1.0 } else { 1.0 };
+            let m = if k % 2 == 0 {
+                Some(FreeMotion::Arc { p })
+            } else {
+                restraint.map(|(lambda, omega)| FreeMotion::Restraint { lambda, omega })
+            };
+            let (i0, i1) = (t.partition_point(|&v| v < c[k - 1]), t.partition_point(|&v| v <= c[k]));
+            ContactPeak {
+                k,
+                crossing_s: c[k],
+                apex_mm: x[i0..i1].iter().map(|v| v.abs()).fold(0.0, f64::max),
+                reading: m.and_then(|m| read_contact(t, &y, c[k - 1], c[k], post_s, m, a.noise_mm, want)),
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -270,5 +571,56 @@ mod tests {
         assert!(time.abs() <= dt, "{time}");
         // A half-cycle too short for four samples a side is not read.
         assert!(read_kink(&t, &y, 0.0, dt, 3, 0.001).is_none());
+    }
+
+    /// A free arc (θ'' = p²(θ − θ_c), x_c = 390 mm) that meets a compliant base
+    /// at x = 2 mm: a Hertz force K d^{3/2} (d the penetration), not the reading's
+    /// own contact form, integrated by RK4 every 10 µs, sampled at `fs` with
+    /// Gaussian noise σ = 0.01 mm. Returns (t, x, crossing, the true velocity
+    /// extreme before the crossing).
+    fn arc_into_hertz(fs: f64, k: f64, seed: u64) -> (Vec<f64>, Vec<f64>, f64, f64) {
+        let (p, xc, x_on, h) = (2.2f64, 390.0, 2.0, 1e-5);
+        let acc = |x: f64| p * p * (x - xc) + k * (x_on - x).max(0.0).powf(1.5);
+        let (mut x, mut v, mut time) = (60.0f64, 0.0f64, 0.0f64);
+        let mut fine = vec![(time, x, v)];
+        while time < 0.6 && x >= -40.0 {
+            let (k1x, k1v) = (v, acc(x));
+            let (k2x, k2v) = (v + 0.5 * h * k1v, acc(x + 0.5 * h * k1x));
+            let (k3x, k3v) = (v + 0.5 * h * k2v, acc(x + 0.5 * h * k2x));
+            let (k4x, k4v) = (v + h * k3v, acc(x + h * k3x));
+            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+            time += h;
+            fine.push((time, x, v));
+        }
+        let i0 = fine.iter().position(|q| q.1 < 0.0).expect("a crossing");
+        let crossing = fine[i0].0;
+        let v_true = fine[..i0].iter().map(|q| q.2).fold(f64::INFINITY, f64::min);
+        let mut rng = crate::synth::Rng::new(seed);
+        let step = (1.0 / fs / h).round() as usize;
+        let (t, x): (Vec<f64>, Vec<f64>) = fine.iter().step_by(step).map(|q| (q.0, q.1 + 0.01 * rng.normal())).unzip();
+        (t, x, crossing, v_true)
+    }
+
+    /// The contact model reads the velocity extreme of an arc that meets a
+    /// compliant base (a force form other than its own) within 1 %, at 200, 500
+    /// and 1000 Hz and two stiffnesses (measured: 0.02–0.7 %). Its u is printed,
+    /// not asserted: it covers four cases within 2 u, and misses the stiff
+    /// contact at 1000 Hz by 3.3 u (docs/restitution-law.md).
+    #[test]
+    fn the_contact_model_reads_a_hertz_contact() {
+        for (fs, k) in [(200.0, 400.0), (500.0, 400.0), (1000.0, 400.0), (500.0, 2000.0), (1000.0, 2000.0)] {
+            let (t, x, crossing, v_true) = arc_into_hertz(fs, k, fs as u64);
+            let r = read_contact(&t, &x, 0.0, crossing, CONTACT_POST_S, FreeMotion::Arc { p: 2.2 }, 0.01, -1.0).expect("a reading");
+            let (v, u) = (r.reading.velocity_mm_s, r.reading.u_mm_s);
+            println!(
+                "{fs} Hz, K {k}: {v:.2} ± {u:.2} against {v_true:.2} ({:+.4}, {:.1} u), χ² {:.1} over {}",
+                v / v_true - 1.0,
+                (v - v_true).abs() / u,
+                r.chi2,
+                r.n
+            );
+            assert!((v / v_true - 1.0).abs() < 0.01, "{fs} Hz, K {k}: {v} ± {u} vs {v_true}");
+        }
     }
 }

@@ -91,7 +91,26 @@ pub fn law_figure(res: &CampaignResult, fit: &LawFit) -> Result<Figure, ReportEr
                 })
                 .collect();
             let constant = fit.constant.r(*side, 0.1);
-            plots::law_panel(&format!("{}: r of every impact, {name}", res.campaign.name), &tests, &law, constant)
+            // The amplitudes this side's law was fitted on ("both" two-sided).
+            let key = if fit.law.parameters.shared {
+                "both"
+            } else if *side == Side::Inward {
+                "in"
+            } else {
+                "out"
+            };
+            let fitted = fit
+                .sides
+                .iter()
+                .find(|(k, _)| k == key)
+                .map_or((0.0, f64::INFINITY), |(_, f)| (f.amplitude_min, f.amplitude_max));
+            plots::law_panel(
+                &format!("{}: r of every impact, {name}", res.campaign.name),
+                &tests,
+                &law,
+                constant,
+                fitted,
+            )
         })
         .collect();
     plots::render(&panels, 900, 420)

@@ -347,10 +347,38 @@ pub const PALETTE: [RGBColor; 6] = [BLUE, RED, GREEN, ORANGE, PURPLE, BROWN];
 /// nine coefficient sets).
 pub const SETS: [RGBColor; 9] = [RED, BLUE, GREEN, ORANGE, PURPLE, BROWN, PINK, OLIVE, CYAN];
 
+/// A law that is not the constant: black with its ±u band over the amplitudes
+/// `fitted` (its side's impacts), olive where it is extrapolated (no ±u there:
+/// the band is the fit's, not the form's, and nothing vouches for the form
+/// beyond its impacts).
+fn law_lines(law: &[(f64, f64, f64)], fitted: (f64, f64)) -> Vec<Series> {
+    let lg = |a: f64| a.max(1e-9).log10();
+    // The curve's samples inside the span, and the parts outside it joined to
+    // their neighbouring sample inside (so that the lines meet).
+    let i0 = law.iter().position(|p| p.0 >= fitted.0).unwrap_or(law.len());
+    let i1 = law.iter().rposition(|p| p.0 <= fitted.1).map_or(0, |i| i + 1);
+    let xy = |part: &[(f64, f64, f64)]| -> Vec<(f64, f64)> { part.iter().map(|&(a, r, _)| (lg(a), r)).collect() };
+    let inside: &[(f64, f64, f64)] = if i0 < i1 { &law[i0..i1] } else { &[] };
+    let below = xy(&law[..(i0 + 1).min(law.len())]);
+    let above = xy(&law[i1.saturating_sub(1).min(law.len())..]);
+    let mut out = Vec::new();
+    let mut label = "law r(a), extrapolated";
+    for part in [below, above] {
+        if part.len() >= 2 {
+            out.push(Series::line(label, OLIVE, part));
+            label = "";
+        }
+    }
+    out.push(Series::line("law r(a)", BLACKISH, inside.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
+    out.push(Series::line("law ± u", GREY, inside.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
+    out.push(Series::line("", GREY, inside.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
+    out
+}
+
 /// One panel of the restitution-law plot (issue 20): r of every impact against
 /// log₁₀ of its amplitude |θ|/α, one marker colour per test; the law with its ±1 u
 /// band; the constant for comparison. `tests`: (id, [(a, r)]); `law`: [(a, r, u)].
-pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, f64, f64)], constant: f64) -> Panel {
+pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, f64, f64)], constant: f64, fitted: (f64, f64)) -> Panel {
     let lg = |a: f64| a.max(1e-9).log10();
     let mut series: Vec<Series> = tests
         .iter()
@@ -375,14 +403,17 @@ pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, 
             vec![(x0, constant), (x1, constant)],
         ));
     }
-    let law_label = if flat {
-        format!("law r(a) = the constant {constant:.3}")
+    if flat {
+        series.push(Series::line(
+            &format!("law r(a) = the constant {constant:.3}"),
+            BLACKISH,
+            law.iter().map(|&(a, r, _)| (lg(a), r)).collect(),
+        ));
+        series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
+        series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
     } else {
-        "law r(a)".to_string()
-    };
-    series.push(Series::line(&law_label, BLACKISH, law.iter().map(|&(a, r, _)| (lg(a), r)).collect()));
-    series.push(Series::line("law ± u", GREY, law.iter().map(|&(a, r, u)| (lg(a), r + u)).collect()));
-    series.push(Series::line("", GREY, law.iter().map(|&(a, r, u)| (lg(a), r - u)).collect()));
+        series.extend(law_lines(law, fitted));
+    }
     Panel::new(
         title,
         "log10 of the amplitude |θ|/α at the apex of the half-cycle the impact ends",
@@ -406,13 +437,26 @@ mod tests {
         let tests = vec![("t1".to_string(), vec![(0.1, 0.9)])];
         let flat = [(0.01, 0.9, 0.01), (0.3, 0.9, 0.01)];
         assert_eq!(
-            labels(&law_panel("x", &tests, &flat, 0.9)),
+            labels(&law_panel("x", &tests, &flat, 0.9, (0.01, 0.3))),
             ["test t1", "law r(a) = the constant 0.900", "law ± u"]
         );
         let falling = [(0.01, 0.8, 0.01), (0.3, 0.95, 0.01)];
         assert_eq!(
-            labels(&law_panel("x", &tests, &falling, 0.9)),
+            labels(&law_panel("x", &tests, &falling, 0.9, (0.01, 0.3))),
             ["test t1", "constant r = 0.900", "law r(a)", "law ± u"]
         );
+        // Fitted on a = 0.01–0.03 only: the law above is drawn as extrapolated,
+        // without a band, and the band covers the fitted amplitudes alone.
+        let curve: Vec<(f64, f64, f64)> = (0..=20)
+            .map(|i| 0.01 * 30f64.powf(i as f64 / 20.0))
+            .map(|a| (a, 1.0 - 0.01 / a.sqrt(), 0.01))
+            .collect();
+        let p = law_panel("x", &tests, &curve, 0.9, (0.01, 0.03));
+        assert_eq!(
+            labels(&p),
+            ["test t1", "constant r = 0.900", "law r(a), extrapolated", "law r(a)", "law ± u"]
+        );
+        let band = p.series.iter().find(|s| s.label == "law ± u").unwrap();
+        assert!(band.points.iter().all(|&(x, _)| x <= 0.03f64.log10() + 1e-12));
     }
 }

@@ -112,12 +112,8 @@ fn structured_unvouched(
     sigma: f64,
     late: &dyn Fn() -> Vec<LatePeak>,
 ) -> Option<String> {
-    let flagged: Vec<usize> = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma)
-        .iter()
-        .map(|f| f.0)
-        .collect();
-    if flagged.is_empty() || vouch::vouched(peaks, &late(), &flagged) {
-        return None;
-    }
-    checks::structured_near_impacts(&fit.tw, resid, onsets, dt, sigma)
+    let flagged = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma);
+    let &(k, r) = flagged.first()?;
+    let ks: Vec<usize> = flagged.iter().map(|f| f.0).collect();
+    (!vouch::vouched(peaks, &late(), &ks)).then(|| checks::structured_reason(k, r, sigma))
 }

@@ -291,3 +291,25 @@ fn compliant_tests_once_taken_for_a_filter() {
         assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);
     }
 }
+
+/// The tests of the full draws that were ok but more than 2 pp off before the
+/// estimate of an unstated filter moved the model's times by the change of
+/// group delay and measured how the rounding changes from the earlier impacts
+/// to the later ones (`peaks::acquisition::rounding_trend`): draw 6122 of
+/// `unstated_causal_families_full_draw` (a Butterworth of order 8 at
+/// 0.32 f_s, 100 Hz: no generic response was fitted, the contact phases read
+/// it 2.33 pp off) is ok and within 1 pp; the compliant draws 1181 (3.02 pp:
+/// its rounding widens as the wall slows, read with contact phases) and 1120
+/// (2.05 pp) are ok within 2 pp or flagged.
+#[test]
+fn tests_once_ok_but_off_are_reduced_or_flagged() {
+    let (syn, logger) = draw_logged(6122, Family::Rigid, all_causal());
+    let s = score_with(&syn, &PeakOptions::default());
+    let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+    assert!(s.status == "ok" && w <= 1.0, "draw 6122 [{logger:?}]: {w:.2} pp, {}", s.status);
+    let scored: Vec<Scored> = [1181, 1120].into_par_iter().map(|i| score(&draw(i, Family::Compliant))).collect();
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);
+    }
+}

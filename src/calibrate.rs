@@ -466,13 +466,48 @@ pub struct Calibration {
     /// Per-impact coefficients from the data, per test: (id, inward, outward).
     pub per_impact: Vec<(String, Vec<f64>, Vec<f64>)>,
     pub included: Vec<String>,
+    /// (id, why) of every test the means leave out: `exclude_from_mean`, suspect
+    /// (with the reducer's reason) or not fitted (with the failure).
+    pub left_out: Vec<(String, String)>,
     pub failed: Vec<(String, TestFailure)>,
+}
+
+impl Calibration {
+    /// "50_1 (exclude_from_mean), 150_3 (suspect: …)".
+    pub fn left_out_text(&self) -> String {
+        self.left_out
+            .iter()
+            .map(|(id, why)| format!("{id} ({why})"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// "50_1 (exclude_from_mean), 150_3 (suspect)": the reasons cut at their first colon.
+    fn left_out_short(&self) -> String {
+        self.left_out
+            .iter()
+            .map(|(id, why)| format!("{id} ({})", why.split(':').next().unwrap_or(why)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Why a calibration has no calibration.toml.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrationFileError {
+    /// Every test is left out: no mean to write (a façade study would read it as e).
+    #[error("no test of {campaign} can be included in the calibration ({why}): calibration.toml needs at least one")]
+    NoIncludedTest { campaign: String, why: String },
+    #[error(transparent)]
+    Toml(#[from] toml::ser::Error),
 }
 
 /// What calibrating one test gave.
 struct TestCalibration {
     id: String,
     exclude_from_mean: bool,
+    /// Why the reducer cannot vouch for this test, if it cannot.
+    suspect: Option<String>,
     fit: Result<(TestWindow, TestFit), TestFailure>,
     /// Per-impact coefficients (inward, outward), when the test was reduced.
     per_impact: Option<(Vec<f64>, Vec<f64>)>,
@@ -480,6 +515,7 @@ struct TestCalibration {
 
 /// Window and fit one reduced test.
 fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usize) -> TestCalibration {
+    let suspect = t.reduced.ok().and_then(Reduced::suspect_reason);
     let (fit, per_impact) = match t.reduced {
         Err(e) => (Err(TestFailure::NotReduced(e.to_string())), None),
         Ok(r) => {
@@ -492,12 +528,17 @@ fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usi
     TestCalibration {
         id: t.id.to_string(),
         exclude_from_mean: t.exclude_from_mean,
+        suspect,
         fit,
         per_impact,
     }
 }
 
-/// Calibrate a reduced campaign (tests in parallel).
+/// Calibrate a reduced campaign (tests in parallel). The means and the joint fit
+/// take the tests the campaign means of `reduce` take: not `exclude_from_mean`,
+/// and not suspect (the reducer's impacts window the replay; where it cannot place
+/// them, the window is not vouched for). The others are fitted and listed, with
+/// why they are left out.
 pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
     use rayon::prelude::*;
     let geom = Geometry::of(c.rocking, &c.wall);
@@ -506,6 +547,7 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
     let mut tests = Vec::new();
     let mut windows = Vec::new();
     let mut included = Vec::new();
+    let mut left_out = Vec::new();
     let mut failed = Vec::new();
     let mut per = Vec::new();
     let mut inc_fits = Vec::new();
@@ -515,14 +557,21 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
         }
         match o.fit {
             Ok((w, f)) => {
-                if !o.exclude_from_mean {
-                    included.push(o.id.clone());
-                    windows.push(w);
-                    inc_fits.push(f.clone());
+                match (o.exclude_from_mean, &o.suspect) {
+                    (true, _) => left_out.push((o.id.clone(), "exclude_from_mean".to_string())),
+                    (false, Some(why)) => left_out.push((o.id.clone(), format!("suspect: {why}"))),
+                    (false, None) => {
+                        included.push(o.id.clone());
+                        windows.push(w);
+                        inc_fits.push(f.clone());
+                    }
                 }
                 tests.push(f);
             }
-            Err(e) => failed.push((o.id, e)),
+            Err(e) => {
+                left_out.push((o.id.clone(), e.to_string()));
+                failed.push((o.id, e));
+            }
         }
     }
     let mean = |f: fn(&TestFit) -> f64| inc_fits.iter().map(f).sum::<f64>() / inc_fits.len().max(1) as f64;
@@ -542,6 +591,7 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
         tests,
         per_impact: per,
         included,
+        left_out,
         failed,
     }
 }
@@ -672,10 +722,21 @@ impl CalibrationFile {
 
 /// calibration.toml of a calibration: a comment saying what the values are, then
 /// [`CalibrationFile`].
-pub fn to_toml(c: &Calibration) -> Result<String, toml::ser::Error> {
+pub fn to_toml(c: &Calibration) -> Result<String, CalibrationFileError> {
+    if c.included.is_empty() {
+        return Err(CalibrationFileError::NoIncludedTest {
+            campaign: c.campaign.clone(),
+            why: if c.left_out.is_empty() {
+                "it has no test".to_string()
+            } else {
+                c.left_out_text()
+            },
+        });
+    }
     let header = format!(
-        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them.\n",
+        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}{}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them.\n",
         c.included.join(", "),
+        if c.left_out.is_empty() { String::new() } else { format!("; left out: {}", c.left_out_short()) },
         if c.rocking == Rocking::OneSided { ", inward spring" } else { "" },
     );
     Ok(header + &toml::to_string(&CalibrationFile::of(c))?)

@@ -303,3 +303,29 @@ fn a_replay_that_runs_away_is_given_up() {
     assert!(rocklab::calibrate::replay(&w, &geom, 0.999, 0.999, rocklab::calibrate::Nuisance(&runaway)).is_none());
     assert!(rocklab::calibrate::replay_step_budget(w.t.len()) < 1_000_000);
 }
+
+/// A test the reducer cannot vouch for is fitted and listed but left out of the
+/// calibration's means, as `reduce` leaves it out of the campaign means: the
+/// reducer's impacts window the replay. The means are then those of the other
+/// tests alone.
+#[test]
+fn a_suspect_test_is_left_out_of_the_means() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut manifest = String::from(MANIFEST_HEAD);
+    for (i, id) in ["a", "b"].iter().enumerate() {
+        std::fs::write(dir.path().join(format!("{id}.csv")), log(200.0, 0.02, 0.05, 140.0, 40 + i as u64)).unwrap();
+        manifest.push_str(&format!("[[test]]\nid = \"{id}\"\nfile = \"{id}.csv\"\n"));
+    }
+    let path = dir.path().join("campaign.toml");
+    std::fs::write(&path, manifest).unwrap();
+    let mut res = reduce_campaign(Campaign::load(&path).unwrap(), PeakOptions::default());
+    let b = res.tests.iter_mut().find(|t| t.spec.id == "b").unwrap();
+    b.result.as_mut().unwrap().analysis.quality = rocklab::peaks::Quality::Suspect(vec!["planted".into()]);
+    let cal = calibrate(&res.calibration_input(), 6);
+    assert_eq!(cal.included, vec!["a".to_string()]);
+    assert_eq!(cal.left_out, vec![("b".to_string(), "suspect: planted".to_string())]);
+    assert_eq!(cal.tests.len(), 2, "the suspect test is still fitted and listed");
+    let a = cal.tests.iter().find(|t| t.id == "a").unwrap();
+    assert_eq!((cal.e_in, cal.e_out), (a.e_in, a.e_out));
+    assert!(rocklab::calibrate::to_toml(&cal).unwrap().contains("left out: b (suspect)"));
+}

@@ -232,3 +232,35 @@ fn a_linked_folder_under_out_is_not_written_through() {
     assert_eq!(tree(&elsewhere).len(), 0, "written through the link");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1, "something written under --out");
 }
+
+// A calibration whose every test is left out of the means has no mean to write:
+// calibration.toml once held e_in = e_out = -0.0 (the mean of nothing), which a
+// façade study would have read as e = 0. The run is refused with the tests and
+// why each is left out; nothing is written and no table of unwritten values is
+// printed.
+#[test]
+fn a_calibration_with_every_test_left_out_writes_nothing() {
+    let root = tempfile::tempdir().unwrap();
+    let demo = fixtures().join("campaigns/two-sided-demo");
+    let manifest = std::fs::read_to_string(demo.join("campaign.toml")).unwrap();
+    let head = &manifest[..manifest.find("[[test]]").unwrap()];
+    let toml = format!("{head}[[test]]\nid = \"A_T0_5\"\nfile = \"A_T0_5.csv\"\nexclude_from_mean = true\n");
+    std::fs::write(root.path().join("campaign.toml"), toml).unwrap();
+    std::fs::copy(demo.join("A_T0_5.csv"), root.path().join("A_T0_5.csv")).unwrap();
+    let out = root.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+        .arg("calibrate")
+        .arg(root.path().join("campaign.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("no test of two-sided-demo can be included in the calibration (A_T0_5 (exclude_from_mean))"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "something was written");
+    assert!(!stdout.contains("| A_T0_5 |"), "a table of unwritten values was printed: {stdout}");
+}

@@ -158,6 +158,7 @@ fn calibration() -> Calibration {
             ("150_2".into(), vec![0.3534, 0.4671, 0.4473], vec![0.8434, 0.8217, 0.9147]),
         ],
         included: vec!["150_1".into(), "150_2".into()],
+        left_out: Vec::new(),
         failed: Vec::new(),
     }
 }

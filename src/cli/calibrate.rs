@@ -34,19 +34,20 @@ pub struct CalibrateArgs {
 pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
     let campaign = Campaign::load(&a.manifest)?;
     let sources = load::campaign_sources(&campaign);
-    let res = super::reduce::reduce_and_print(campaign, PeakOptions::default());
+    let res = super::reduce::reduce_with_progress(campaign, PeakOptions::default());
     let cal = calibrate_and_write(&res, &sources, &a.out, a.impacts)?;
     Ok(if cal.failed.is_empty() { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 /// Calibrate a reduced campaign, write everything `reduce` writes with the
-/// calibration on top, and print the calibration table.
+/// calibration on top, then print the reduction and the calibration table.
 pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, n: usize) -> anyhow::Result<Calibration> {
     let start = std::time::Instant::now();
     let (cal, law) = calibrate_with_law(&res.calibration_input(), n);
     let wall = start.elapsed().as_secs_f64();
     let files = calibration_files(res, &cal, Some(&law), n, wall, sources)?;
     write_files(out, &files).with_context(|| format!("writing {}", out.display()))?;
+    super::reduce::print_reduction(res);
     say(&format!(
         "calibration of {} ({} rocking), {} impacts per test, {:.2} s:",
         cal.campaign, cal.rocking, n, wall

@@ -6,7 +6,7 @@
 
 use std::process::ExitCode;
 
-use super::reduce::reduce_and_print;
+use super::reduce::{print_reduction, reduce_with_progress};
 use super::{say, DemoArgs};
 use rocklab::ingest::Campaign;
 use rocklab::peaks::PeakOptions;
@@ -17,7 +17,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
         let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
         let campaign = Campaign::load(&manifest)?;
         let sources = super::load::campaign_sources(&campaign);
-        let res = reduce_and_print(campaign, PeakOptions::default());
+        let res = reduce_with_progress(campaign, PeakOptions::default());
         ok &= res.failed().next().is_none();
         // Writes everything `reduce` writes, with the calibration on top.
         let cal = super::calibrate::calibrate_and_write(&res, &sources, &args.out.join(name), 6)?;
@@ -58,9 +58,10 @@ fn reduce_for_law(args: &DemoArgs, name: &str) -> anyhow::Result<bool> {
     let manifest = args.fixtures.join("campaigns").join(name).join("campaign.toml");
     let campaign = Campaign::load(&manifest)?;
     let sources = super::load::campaign_sources(&campaign);
-    let res = reduce_and_print(campaign, PeakOptions::default());
+    let res = reduce_with_progress(campaign, PeakOptions::default());
     let files = rocklab::report::reduce_files(&res, &sources, true, &rocklab::report::Extras::default())?;
     rocklab::report::write_files(&args.out.join(name), &files)?;
+    print_reduction(&res);
     say("");
     let ok = res.failed().next().is_none();
     Ok(ok)

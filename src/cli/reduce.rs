@@ -27,17 +27,19 @@ pub fn run(args: ReduceArgs) -> anyhow::Result<ExitCode> {
     let opts = options(&args.estimator)?;
     let campaign = Campaign::load(&args.manifest)?;
     let sources = load::campaign_sources(&campaign);
-    let res = reduce_and_print(campaign, opts);
+    let res = reduce_with_progress(campaign, opts);
     let files = report::reduce_files(&res, &sources, !args.estimator.no_plots, &report::Extras::default())?;
     report::write_files(&args.out, &files).with_context(|| format!("writing {}", args.out.display()))?;
+    print_reduction(&res);
     say(&format!("wrote {}", args.out.display()));
     Ok(exit_code(&res))
 }
 
-/// Reduce a campaign and print what a user reads on the terminal (the campaign,
-/// Table 1, warnings and failures); shared by `calibrate` and `demo`, which write
-/// the outputs themselves.
-pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult {
+/// Reduce a campaign, saying which campaign and showing progress; shared by
+/// `calibrate` and `demo`. What it found is printed by [`print_reduction`] once
+/// the outputs are written (a refused write prints no table of values that were
+/// not written).
+pub fn reduce_with_progress(campaign: Campaign, opts: PeakOptions) -> CampaignResult {
     say(&format!(
         "campaign {} ({}), {} tests; α = {:.4} rad ({}); e_H = {:.4} ({})",
         campaign.name,
@@ -51,12 +53,18 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
     let pb = super::progress(campaign.tests.len(), "reducing tests");
     let res = reduce_campaign_with(campaign, opts, &|| pb.inc(1));
     pb.finish_and_clear();
+    res
+}
+
+/// What a user reads on the terminal of a reduction: warnings, Table 1, the
+/// tests the means leave out, suspect tests and failures.
+pub fn print_reduction(res: &CampaignResult) {
     for t in &res.tests {
         for w in &t.warnings {
             super::tell(&format!("warning: test {}: {w}", t.spec.id));
         }
     }
-    say(&tables::to_markdown(&tables::tables(&res)[0]));
+    say(&tables::to_markdown(&tables::tables(res)[0]));
     if !res.means.left_out.is_empty() {
         say(&format!("means leave out: {}", res.means.left_out_text()));
     }
@@ -75,7 +83,6 @@ pub fn reduce_and_print(campaign: Campaign, opts: PeakOptions) -> CampaignResult
             super::tell(&format!("  test {id}: {e}"));
         }
     }
-    res
 }
 
 pub fn exit_code(res: &CampaignResult) -> ExitCode {

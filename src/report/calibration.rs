@@ -39,6 +39,15 @@ pub fn calibration_files(
     Ok(files)
 }
 
+/// " (left out: 50_1 (exclude_from_mean), …)", or nothing when every test is in.
+fn left_out_clause(cal: &Calibration) -> String {
+    if cal.left_out.is_empty() {
+        String::new()
+    } else {
+        format!(" (left out: {})", cal.left_out_text())
+    }
+}
+
 /// The calibration per test: e_in and e_out with their 95 % intervals, the fit's
 /// residual and how it stopped.
 pub fn calibration_table(cal: &Calibration) -> Table {
@@ -55,10 +64,11 @@ pub fn calibration_table(cal: &Calibration) -> Table {
         Column::new("stop", "stop", Align::Left),
     ];
     let caption = format!(
-        "Calibration of {} ({} rocking): e_in and e_out fitted per test by replaying it with the solver; means over {}: e_in = {:.3} (r_in {:.3}), e_out = {:.3} (r_out {:.3}).",
+        "Calibration of {} ({} rocking): e_in and e_out fitted per test by replaying it with the solver; means over {}{}: e_in = {:.3} (r_in {:.3}), e_out = {:.3} (r_out {:.3}).",
         cal.campaign,
         cal.rocking,
         cal.included.join(", "),
+        left_out_clause(cal),
         cal.e_in,
         cal.r_in,
         cal.e_out,
@@ -112,9 +122,10 @@ pub fn per_impact_table(cal: &Calibration) -> Table {
 /// The calibration section of report.html.
 fn calibration_html(cal: &Calibration, law: Option<&LawReplay>, n: usize, figs: &[Captioned]) -> String {
     let mut s = format!(
-        "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
+        "<h2>Calibration: e_in and e_out replaying each test with the solver</h2>\n<p>Each test is replayed with the rocking solver (Eq. 1, free rocking) from the release and fitted to the displacement over its first {n} impacts (Levenberg–Marquardt; release time, zero offset, p² factor{} free). Means over {}{}: <b>e_in = {:.3}</b> (r_in = {:.3}), <b>e_out = {:.3}</b> (r_out = {:.3}); e_H = {:.4}.</p>\n",
         if cal.rocking == crate::wall::Rocking::OneSided { " and inward spring" } else { "" },
         escape(&cal.included.join(", ")),
+        escape(&left_out_clause(cal)),
         cal.e_in,
         cal.r_in,
         cal.e_out,

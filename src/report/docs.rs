@@ -94,6 +94,8 @@ struct CalibrationDoc<'a> {
     r_out: f64,
     e_housner: f64,
     included: &'a [String],
+    /// Every test the means leave out, with why (suspect tests included).
+    left_out: Vec<super::summary::LeftOut<'a>>,
     joint: &'a Option<JointFit>,
     tests: &'a [TestFit],
     per_impact: Vec<PerImpact<'a>>,
@@ -116,6 +118,7 @@ pub fn calibration_summary(cal: &Calibration, law: Option<&crate::law_replay::La
         r_out: cal.r_out,
         e_housner: cal.e_housner,
         included: &cal.included,
+        left_out: cal.left_out.iter().map(|(id, why)| super::summary::LeftOut { id, why }).collect(),
         joint: &cal.joint,
         tests: &cal.tests,
         per_impact: cal.per_impact.iter().map(|(id, i, o)| PerImpact { id, inward: i, outward: o }).collect(),

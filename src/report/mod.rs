@@ -36,6 +36,9 @@ pub enum ReportError {
     Json(#[from] serde_json::Error),
     #[error("TOML: {0}")]
     Toml(#[from] toml::ser::Error),
+    /// A calibration with nothing to write (every test left out).
+    #[error("{0}; nothing was written")]
+    Calibration(#[from] crate::calibrate::CalibrationFileError),
     #[error("writing {path}: {source}")]
     Write { path: PathBuf, source: std::io::Error },
     /// An output path that would leave the output folder, or two outputs under one name.

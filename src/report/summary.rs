@@ -174,9 +174,9 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
 }
 
 #[derive(serde::Serialize)]
-struct LeftOut<'a> {
-    id: &'a str,
-    why: &'a str,
+pub(super) struct LeftOut<'a> {
+    pub(super) id: &'a str,
+    pub(super) why: &'a str,
 }
 
 /// The whole document.

@@ -197,11 +197,47 @@ pub fn window_to(id: &str, r: &Reduced, lever_mm: f64, t_end: f64) -> TestWindow
     }
 }
 
+/// The replay's domain of a coefficient: 0 < e < `E_DOMAIN` (wider than the
+/// physical 0–1, so that a fit is not held at 1 and its verdict can see it).
+pub const E_DOMAIN: f64 = 1.5;
+
+/// How near the domain's edges (× [`E_DOMAIN`]) a fitted coefficient counts as
+/// run to the edge: the least squares stopped against the domain, not at a minimum.
+const EDGE: f64 = 1e-3;
+
+/// Why a test's fit is not a measurement of its coefficients, if it is not:
+/// a coefficient run to the edge of the replay's domain (0 or [`E_DOMAIN`]), or
+/// one above 1 beyond its 95 % interval (an impact that returns more speed than
+/// it took: the replay's rigid block does not follow this wall). Such a test is
+/// listed but left out of the calibration's means.
+pub fn fit_verdict(f: &TestFit) -> Option<String> {
+    let shared = f.e_in == f.e_out;
+    let sides = [("e_in", f.e_in, f.ci95_e_in), ("e_out", f.e_out, f.ci95_e_out)];
+    let why: Vec<String> = sides
+        .iter()
+        .take(if shared { 1 } else { 2 })
+        .filter_map(|&(name, e, ci)| {
+            let name = if shared { "e" } else { name };
+            if e <= EDGE * E_DOMAIN || e >= (1.0 - EDGE) * E_DOMAIN {
+                Some(format!("{name} = {e:.3} is at the edge of the replay's domain (0–{E_DOMAIN})"))
+            } else if ci[0] > 1.0 {
+                Some(format!(
+                    "{name} = {e:.3} (95 % {:.3}–{:.3}) is above 1: an impact cannot return more speed than it took",
+                    ci[0], ci[1]
+                ))
+            } else {
+                None
+            }
+        })
+        .collect();
+    (!why.is_empty()).then(|| format!("{}: the replay does not follow this wall", why.join("; ")))
+}
+
 /// Modelled readings of one test for coefficients (e_in, e_out) and nuisance
 /// parameters `nu`; None outside the model's domain (e ∉ (0, 1.5), or a release
 /// displacement beyond the lever arm).
 pub fn replay(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, nu: Nuisance) -> Option<Vec<f64>> {
-    if !(e_in > 0.0 && e_in < 1.5 && e_out > 0.0 && e_out < 1.5) {
+    if !(e_in > 0.0 && e_in < E_DOMAIN && e_out > 0.0 && e_out < E_DOMAIN) {
         return None;
     }
     replay_with(w, geom, e_in, e_out, None, nu)
@@ -537,8 +573,9 @@ fn calibrate_test(t: &TestInput, geom: &Geometry, single_e: bool, n_impacts: usi
 /// Calibrate a reduced campaign (tests in parallel). The means and the joint fit
 /// take the tests the campaign means of `reduce` take: not `exclude_from_mean`,
 /// and not suspect (the reducer's impacts window the replay; where it cannot place
-/// them, the window is not vouched for). The others are fitted and listed, with
-/// why they are left out.
+/// them, the window is not vouched for); and of those, the tests whose fit
+/// [`fit_verdict`] vouches for. The others are fitted and listed, with why they
+/// are left out.
 pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
     use rayon::prelude::*;
     let geom = Geometry::of(c.rocking, &c.wall);
@@ -557,10 +594,11 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
         }
         match o.fit {
             Ok((w, f)) => {
-                match (o.exclude_from_mean, &o.suspect) {
-                    (true, _) => left_out.push((o.id.clone(), "exclude_from_mean".to_string())),
-                    (false, Some(why)) => left_out.push((o.id.clone(), format!("suspect: {why}"))),
-                    (false, None) => {
+                match (o.exclude_from_mean, &o.suspect, fit_verdict(&f)) {
+                    (true, ..) => left_out.push((o.id.clone(), "exclude_from_mean".to_string())),
+                    (false, Some(why), _) => left_out.push((o.id.clone(), format!("suspect: {why}"))),
+                    (false, None, Some(why)) => left_out.push((o.id.clone(), format!("fit not vouched for: {why}"))),
+                    (false, None, None) => {
                         included.push(o.id.clone());
                         windows.push(w);
                         inc_fits.push(f.clone());
@@ -803,5 +841,43 @@ mod tests {
             serde_json::json!("not reduced: x.csv: file not found")
         );
         assert!(cal.joint.is_none() && cal.tests.is_empty());
+    }
+
+    fn fitted(e_in: f64, se_in: f64, e_out: f64, se_out: f64) -> TestFit {
+        TestFit {
+            id: "a".into(),
+            e_in,
+            e_out,
+            se_e_in: se_in,
+            se_e_out: se_out,
+            ci95_e_in: [e_in - 1.96 * se_in, e_in + 1.96 * se_in],
+            ci95_e_out: [e_out - 1.96 * se_out, e_out + 1.96 * se_out],
+            release_offset_s: 0.0,
+            zero_offset_mm: 0.0,
+            p2_factor: 1.0,
+            kappa_per_s2: None,
+            rms_mm: 0.1,
+            nrmse: 0.01,
+            iterations: 5,
+            stop: FitStop::Converged,
+            samples: 100,
+            replay_mm: Vec::new(),
+        }
+    }
+
+    /// A fit against the domain's edge, or above 1 beyond its interval, is not a
+    /// measurement; above 1 within the interval, or inside 0–1, it is.
+    #[test]
+    fn fits_at_the_edge_or_above_one_are_not_vouched_for() {
+        assert_eq!(fit_verdict(&fitted(0.45, 0.01, 0.85, 0.01)), None);
+        assert_eq!(fit_verdict(&fitted(0.45, 0.01, 1.02, 0.02)), None, "1 is inside its interval");
+        let edge = fit_verdict(&fitted(0.45, 0.01, 1.4999, 0.3)).unwrap();
+        assert!(edge.starts_with("e_out = 1.500 is at the edge of the replay's domain (0–1.5)"), "{edge}");
+        let low = fit_verdict(&fitted(1e-4, 0.01, 0.8, 0.01)).unwrap();
+        assert!(low.starts_with("e_in = 0.000 is at the edge"), "{low}");
+        let above = fit_verdict(&fitted(0.45, 0.01, 1.2, 0.05)).unwrap();
+        assert!(above.starts_with("e_out = 1.200 (95 % 1.102–1.298) is above 1"), "{above}");
+        let shared = fit_verdict(&fitted(1.2, 0.05, 1.2, 0.05)).unwrap();
+        assert!(shared.starts_with("e = 1.200") && !shared.contains("e_out"), "said once: {shared}");
     }
 }

@@ -161,7 +161,7 @@ impl LawPacking {
     /// The law of q, None outside 0 < r∞ e_H < 1.5, |c| < 1.
     fn law(&self, q: &[f64], e_h: f64) -> Option<RestitutionLaw> {
         let (i, o) = self.sides(q);
-        let ok = |s: [f64; 2]| s[0] > 0.0 && s[0] * e_h < 1.5 && s[1].abs() < 1.0;
+        let ok = |s: [f64; 2]| s[0] > 0.0 && s[0] * e_h < crate::calibrate::E_DOMAIN && s[1].abs() < 1.0;
         if !(ok(i) && ok(o)) {
             return None;
         }
@@ -206,8 +206,8 @@ pub struct SideReplay {
     pub cov: [[f64; 2]; 2],
     /// Correlation of r∞ and c (None where either has no spread).
     pub correlation: Option<f64>,
-    /// c / u(c).
-    pub z: f64,
+    /// c / u(c); None where u(c) is 0 or undefined (the data do not constrain c).
+    pub z: Option<f64>,
     /// The constant by replay over the same window (r = e/e_H) and its u.
     pub constant_r: f64,
     pub constant_u: f64,
@@ -216,37 +216,39 @@ pub struct SideReplay {
     pub reason: Option<String>,
 }
 
+/// Why c = `c` ± `u1` (c/u = `z` < [`Z_SEPARATE`]) is not kept: the replay
+/// cannot separate r∞ from c, or finds no speed loss (the change of r across the
+/// amplitudes is then within [`MAX_TREND_U`]).
+fn not_separated(c: f64, u1: f64, z: f64, correlation: Option<f64>, span: (f64, f64)) -> String {
+    let trend_u = u1 * (speed_shape(span.0) - speed_shape(span.1));
+    if trend_u > MAX_TREND_U {
+        format!(
+            "the replay cannot separate r_inf from c over a = {:.3}–{:.3}: c = {c:.2e} ± {u1:.2e} (c/u = {z:.2} < {Z_SEPARATE}; correlation of r_inf and c {}; the change of r across these amplitudes is uncertain by ± {trend_u:.3})",
+            span.0,
+            span.1,
+            correlation.map_or("undefined".to_string(), |c| format!("{c:.3}"))
+        )
+    } else {
+        format!(
+            "the replay finds no speed loss over a = {:.3}–{:.3}: c = {c:.2e} ± {u1:.2e} (c/u = {z:.2} < {Z_SEPARATE}; the change of r across these amplitudes ± {trend_u:.3})",
+            span.0, span.1
+        )
+    }
+}
+
 /// The verdict of one side from its law and its constant (module docs).
 fn verdict(side: &'static str, law: [f64; 2], cov: [[f64; 2]; 2], constant: (f64, f64), span: (f64, f64)) -> SideReplay {
     let (u0, u1) = (cov[0][0].max(0.0).sqrt(), cov[1][1].max(0.0).sqrt());
     let correlation = (u0 > 0.0 && u1 > 0.0).then(|| cov[0][1] / (u0 * u1));
-    let z = if u1 > 0.0 { law[1] / u1 } else { f64::NAN };
-    let reason = if !z.is_finite() {
-        Some("the replay gives c no uncertainty (the data do not constrain it)".to_string())
-    } else if law[1] <= 0.0 {
-        Some(format!(
+    let z = (u1 > 0.0).then(|| law[1] / u1).filter(|z| z.is_finite());
+    let reason = match z {
+        None => Some("the replay gives c no uncertainty (the data do not constrain it)".to_string()),
+        Some(_) if law[1] <= 0.0 => Some(format!(
             "the replay's speed loss is not positive (c = {:.4} ± {:.4}): no loss growing as the amplitude falls",
             law[1], u1
-        ))
-    } else if z < Z_SEPARATE {
-        let trend_u = u1 * (speed_shape(span.0) - speed_shape(span.1));
-        Some(if trend_u > MAX_TREND_U {
-            format!(
-                "the replay cannot separate r_inf from c over a = {:.3}–{:.3}: c = {:.2e} ± {:.2e} (c/u = {z:.2} < {Z_SEPARATE}; correlation of r_inf and c {}; the change of r across these amplitudes is uncertain by ± {trend_u:.3})",
-                span.0,
-                span.1,
-                law[1],
-                u1,
-                correlation.map_or("undefined".to_string(), |c| format!("{c:.3}"))
-            )
-        } else {
-            format!(
-                "the replay finds no speed loss over a = {:.3}–{:.3}: c = {:.2e} ± {:.2e} (c/u = {z:.2} < {Z_SEPARATE}; the change of r across these amplitudes ± {trend_u:.3})",
-                span.0, span.1, law[1], u1
-            )
-        })
-    } else {
-        None
+        )),
+        Some(z) if z < Z_SEPARATE => Some(not_separated(law[1], u1, z, correlation, span)),
+        Some(_) => None,
     };
     SideReplay {
         side,
@@ -563,7 +565,7 @@ fn test_outcome(t: &crate::calibrate::TestInput, fits: &[TestFit], geom: &Geomet
     let (w, hc) = law_window(t.id, r, t.lever_arm_m * 1e3).ok_or("fewer than three half-cycles above the noise")?;
     let law = fit_test_law(&w, &hc, geom, e_h, fit).ok_or_else(|| "the law replay failed (a replay outside the model's domain)".to_string())?;
     let finite = |s: &SideReplay| {
-        [s.r_inf, s.c, s.z, s.constant_r, s.constant_u]
+        [s.r_inf, s.c, s.z.unwrap_or(f64::NAN), s.constant_r, s.constant_u]
             .into_iter()
             .chain(s.cov.into_iter().flatten())
             .all(f64::is_finite)
@@ -619,5 +621,19 @@ mod tests {
         assert_eq!(m, [2.0, 1.0]);
         assert!((c[0][0] - 1.0).abs() < 1e-15 && (c[0][1] - 1.0).abs() < 1e-15);
         assert_eq!(mean_cov(&[[1.0, 2.0]], [[9.0; 2]; 2]).1, [[9.0; 2]; 2]);
+    }
+
+    /// Tests whose c are all the same (the replay left c where it started, as the
+    /// outward sides of mujoco-holdout-one-sided did) give the campaign's c no
+    /// spread: c/u is undefined, the side keeps its constant with that reason, and
+    /// nothing non-finite reaches summary.json (its writer once refused the whole
+    /// calibration over `"z": NaN`).
+    #[test]
+    fn a_side_whose_c_has_no_spread_keeps_its_constant_without_nan() {
+        let (m, cov) = super::mean_cov(&[[1.4, 0.0], [1.5, 0.0]], [[0.0; 2]; 2]);
+        let s = super::verdict("out", m, cov, (1.45, 0.05), (0.01, 0.03));
+        assert_eq!(s.z, None);
+        assert!(!s.separated && s.reason.as_deref().unwrap().contains("no uncertainty"), "{:?}", s.reason);
+        assert_eq!(serde_json::to_value(&s).unwrap()["z"], serde_json::Value::Null);
     }
 }

@@ -272,7 +272,7 @@ fn law_by_replay_recovers_its_own_law() {
         let s = &fit.sides[0];
         println!(
             "made with {law:?}: {} impacts over a = {:.3}–{:.3}; r_inf {:.4}, c {:.4} ± {:.4} (z {:.1}), constant {:.4}; RMS {:.4} mm (constant {:.4}); {:?}",
-            fit.impacts, fit.amplitude_min, fit.amplitude_max, s.r_inf, s.c, s.cov[1][1].sqrt(), s.z, s.constant_r, fit.law_rms_mm, fit.constant_rms_mm, s.reason
+            fit.impacts, fit.amplitude_min, fit.amplitude_max, s.r_inf, s.c, s.cov[1][1].sqrt(), s.z.unwrap_or(f64::NAN), s.constant_r, fit.law_rms_mm, fit.constant_rms_mm, s.reason
         );
         assert!(fit.impacts >= 10, "{} impacts", fit.impacts);
         match law {

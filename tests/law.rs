@@ -680,7 +680,7 @@ fn mujoco_law_by_replay() {
                     s.c,
                     s.cov[1][1].sqrt(),
                     s.correlation,
-                    s.z,
+                    s.z.unwrap_or(f64::NAN),
                     s.constant_r,
                     s.reason.as_deref().unwrap_or("law")
                 );

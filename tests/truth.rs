@@ -463,7 +463,8 @@ fn print_readings(id: &str, r: &rocklab::reduce::Reduced, lever_mm: f64, true_v:
         std::fs::write(Path::new(&dir).join(format!("{id}.curve")), text).unwrap();
     }
     println!(
-        "    p {:?}, lambda {:?}, gamma {:?}, contact phases {}; speeds after/before each impact {:?}",
+        "    response {}, p {:?}, lambda {:?}, gamma {:?}, contact phases {}; speeds after/before each impact {:?}",
+        a.response.describe(),
         a.p_fit,
         a.lambda_fit,
         a.gamma_fit,

@@ -99,8 +99,9 @@ fn random_compliant_tests_small_draw() {
 }
 
 /// The issue's draw: 500 resolvable tests of the idealised model. Measured
-/// 100 % ok and within 1 pp (worst 0.86 pp), no test more than 5 pp off with
-/// status ok. The bound is the issue's 99.5 %.
+/// 99.8 % ok and within 1 pp (worst 0.86 pp; one flagged, 0.04 pp off: an
+/// estimated filter whose contact reading differs), no test more than 5 pp
+/// off with status ok. The bound is the issue's 99.5 %.
 #[test]
 #[ignore = "the full draw of issue #9: run in release (see the module docs)"]
 fn random_rigid_tests_full_draw() {
@@ -111,8 +112,8 @@ fn random_rigid_tests_full_draw() {
 }
 
 /// 200 tests with finite-duration lossy contacts (the compliant generator): none
-/// more than 5 pp off with status ok. Measured 75.5 % ok within 1 pp, 20
-/// flagged, worst ok 3.02 pp (draw 1181; docs/accuracy.md). The success rate is
+/// more than 5 pp off with status ok. Measured 80.5 % ok within 1 pp, 23
+/// flagged, worst ok 1.74 pp (draw 1018; docs/acquisition.md). The success rate is
 /// printed, asserted only above 55 %: this family is where the estimator's
 /// contact model is still weak.
 #[test]
@@ -245,12 +246,12 @@ fn stated_causal_families_full_draw() {
     assert!(rate >= 0.98, "success rate {rate}");
 }
 
-/// The same, not stated: measured 98.5 % ok within 1 pp, and ONE test ok but
-/// 2.33 pp off (draw 6122, a Butterworth of order 8 at 0.32 f_s, 100 Hz, read
-/// as a Bessel 4 with no runner-up close enough to flag it). A known gap
-/// (docs/acquisition.md): this test fails until it is closed.
+/// The same, not stated: measured 98.0 % ok within 1 pp, 4 flagged (0.04–0.81
+/// pp off), none ok and more than 2 pp off (draw 6122, an 8th-order
+/// Butterworth once ok but 2.33 pp off, is in
+/// `tests_once_ok_but_off_are_reduced_or_flagged`).
 #[test]
-#[ignore = "known gap, fails on one test (docs/acquisition.md): run in release"]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
 fn unstated_causal_families_full_draw() {
     let (rate, off) = summarise_logged("unstated causal", &run_logged(6000..6200, all_causal(), false));
     assert_eq!(off, 0);
@@ -286,6 +287,28 @@ fn compliant_tests_once_taken_for_a_filter() {
         .into_par_iter()
         .map(|i| score(&draw(i, Family::Compliant)))
         .collect();
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);
+    }
+}
+
+/// The tests of the full draws that were ok but more than 2 pp off before the
+/// estimate of an unstated filter moved the model's times by the change of
+/// group delay and measured how the rounding changes from the earlier impacts
+/// to the later ones (`peaks::acquisition::rounding_trend`): draw 6122 of
+/// `unstated_causal_families_full_draw` (a Butterworth of order 8 at
+/// 0.32 f_s, 100 Hz: no generic response was fitted, the contact phases read
+/// it 2.33 pp off) is ok and within 1 pp; the compliant draws 1181 (3.02 pp:
+/// its rounding widens as the wall slows, read with contact phases) and 1120
+/// (2.05 pp) are ok within 2 pp or flagged.
+#[test]
+fn tests_once_ok_but_off_are_reduced_or_flagged() {
+    let (syn, logger) = draw_logged(6122, Family::Rigid, all_causal());
+    let s = score_with(&syn, &PeakOptions::default());
+    let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+    assert!(s.status == "ok" && w <= 1.0, "draw 6122 [{logger:?}]: {w:.2} pp, {}", s.status);
+    let scored: Vec<Scored> = [1181, 1120].into_par_iter().map(|i| score(&draw(i, Family::Compliant))).collect();
     for s in &scored {
         let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
         assert!(s.status != "ok" || w <= 2.0, "seed {}: {w:.2} pp with status ok", s.seed);

@@ -162,7 +162,10 @@ fn legend_width<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, entries: &[En
     let font = ("sans-serif", LEGEND_FONT).into_text_style(area);
     let widest = entries
         .iter()
-        .filter_map(|e| area.estimate_text_size(e.label, &font).ok())
+        .filter_map(|e| {
+            let head: String = e.label.chars().take(LABEL_CHARS + 1).collect();
+            area.estimate_text_size(&head, &font).ok()
+        })
         .map(|(w, _)| w)
         .max()
         .unwrap_or(0);
@@ -191,17 +194,31 @@ where
     Ok(())
 }
 
-/// `label`, cut with "…" until it is at most `room` pixels wide.
+/// Labels longer than this are cut before they are measured: no legend column
+/// shows as many characters, and measuring a label costs its length.
+const LABEL_CHARS: usize = 200;
+
+/// `label`, cut with "…" to the longest prefix that is at most `room` pixels
+/// wide with it (a binary search on the prefix's length: a test id of 100,000
+/// characters once took minutes, cut one character at a time).
 fn fit_label<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str, font: &TextStyle, room: u32) -> String {
     let wide = |s: &str| area.estimate_text_size(s, font).map(|(w, _)| w > room).unwrap_or(false);
-    if !wide(label) {
+    let chars: Vec<char> = label.chars().take(LABEL_CHARS + 1).collect();
+    if chars.len() <= LABEL_CHARS && !wide(label) {
         return label.to_string();
     }
-    let mut chars: Vec<char> = label.chars().collect();
-    while !chars.is_empty() && wide(&format!("{}…", chars.iter().collect::<String>())) {
-        chars.pop();
+    let cut = |n: usize| format!("{}…", chars[..n].iter().collect::<String>());
+    // The longest n in 0..=LABEL_CHARS with cut(n) narrow enough (0 if none is).
+    let (mut lo, mut hi) = (0, chars.len().min(LABEL_CHARS));
+    while lo < hi {
+        let mid = (lo + hi).div_ceil(2);
+        if wide(&cut(mid)) {
+            hi = mid - 1;
+        } else {
+            lo = mid;
+        }
     }
-    format!("{}…", chars.iter().collect::<String>())
+    cut(lo)
 }
 
 /// The colour of a panel's horizontal line.
@@ -214,7 +231,9 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, panel: &Panel, 
 where
     DB::ErrorType: 'static,
 {
-    let area = area.titled(&panel.title, ("sans-serif", 18)).map_err(err)?;
+    let title_font = ("sans-serif", 18).into_text_style(area);
+    let title = fit_label(area, &panel.title, &title_font, area.dim_in_pixel().0.saturating_sub(10));
+    let area = area.titled(&title, title_font).map_err(err)?;
     let legend = entries(panel);
     let (plot, side) = area.split_horizontally(area.dim_in_pixel().0 - lw);
     draw_chart(&plot, panel)?;

@@ -511,11 +511,7 @@ pub struct Calibration {
 impl Calibration {
     /// "50_1 (exclude_from_mean), 150_3 (suspect: …)".
     pub fn left_out_text(&self) -> String {
-        self.left_out
-            .iter()
-            .map(|(id, why)| format!("{id} ({why})"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        crate::campaign_means::left_out_text(&self.left_out)
     }
 
     /// "50_1 (exclude_from_mean), 150_3 (suspect)": the reasons cut at their first colon.

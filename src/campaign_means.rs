@@ -42,12 +42,13 @@ pub struct CampaignMeans {
 impl CampaignMeans {
     /// "50_1 (exclude_from_mean), 100_2 (not reduced)".
     pub fn left_out_text(&self) -> String {
-        self.left_out
-            .iter()
-            .map(|(id, why)| format!("{id} ({why})"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        left_out_text(&self.left_out)
     }
+}
+
+/// "50_1 (exclude_from_mean), 100_2 (not reduced)" of (id, why) pairs.
+pub fn left_out_text(left_out: &[(String, String)]) -> String {
+    left_out.iter().map(|(id, why)| format!("{id} ({why})")).collect::<Vec<_>>().join(", ")
 }
 
 /// A statistic of one quantity over the included tests (its mean, its standard error).

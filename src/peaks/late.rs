@@ -581,10 +581,7 @@ fn read_contact_on(
 /// among the coarse scores' best or next to one of them
 /// (`restraint_search_is_the_exhaustive_one`).
 pub fn restraint_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma: f64) -> Option<(f64, f64)> {
-    let windows: Vec<(Vec<f64>, Vec<f64>)> = halves.iter().map(|&(a, b)| contact_window(t, y, a, b, post_s)).collect();
-    let mut lengths: Vec<f64> = halves.iter().map(|&(a, b)| b - a).collect();
-    lengths.sort_by(f64::total_cmp);
-    let omega0 = std::f64::consts::PI / *lengths.get(lengths.len() / 2)?;
+    let (windows, omega0) = restraint_windows(t, y, halves, post_s)?;
     let grid = RestraintGrid {
         windows: &windows,
         omega0,
@@ -652,14 +649,24 @@ impl RestraintGrid<'_> {
     }
 }
 
+/// One contact window: its times and readings.
+type Window = (Vec<f64>, Vec<f64>);
+
+/// The contact window of each inward half-cycle `halves` and the grid's base
+/// ω₀ = π / (the median half-cycle length); None without a half-cycle.
+fn restraint_windows(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64) -> Option<(Vec<Window>, f64)> {
+    let windows = halves.iter().map(|&(a, b)| contact_window(t, y, a, b, post_s)).collect();
+    let mut lengths: Vec<f64> = halves.iter().map(|&(a, b)| b - a).collect();
+    lengths.sort_by(f64::total_cmp);
+    let omega0 = std::f64::consts::PI / *lengths.get(lengths.len() / 2)?;
+    Some((windows, omega0))
+}
+
 /// The exhaustive search over every pair of the grid at every onset (the
 /// reference of [`restraint_of`]'s coarse-to-fine search).
 #[cfg(test)]
 fn restraint_exhaustive(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma: f64) -> Option<(f64, f64)> {
-    let windows: Vec<(Vec<f64>, Vec<f64>)> = halves.iter().map(|&(a, b)| contact_window(t, y, a, b, post_s)).collect();
-    let mut lengths: Vec<f64> = halves.iter().map(|&(a, b)| b - a).collect();
-    lengths.sort_by(f64::total_cmp);
-    let omega0 = std::f64::consts::PI / *lengths.get(lengths.len() / 2)?;
+    let (windows, omega0) = restraint_windows(t, y, halves, post_s)?;
     let grid = RestraintGrid {
         windows: &windows,
         omega0,

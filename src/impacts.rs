@@ -392,6 +392,7 @@ mod tests {
                 },
                 chi2: if fits { 20.0 } else { 200.0 },
                 n: 25,
+                params: 5,
             }),
         }
     }

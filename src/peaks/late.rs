@@ -579,11 +579,11 @@ fn contact_fits_every(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape
 /// 0.7 % and the fit's terms alone missed that by up to 7 u (unit test).
 #[allow(clippy::too_many_arguments)]
 pub fn read_contact(t: &[f64], y: &[f64], start: f64, zero: f64, post_s: f64, m: FreeMotion, sigma: f64, want: f64) -> Option<ContactReading> {
-    let main = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Jump, sigma, want)?;
-    let shorter = read_contact_on(t, y, start, zero, post_s * 2.0 / 3.0, m, ContactShape::Jump, sigma, want)?;
-    let ramp = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Ramp, sigma, want)?;
+    let main = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Ramp, sigma, want)?;
+    let shorter = read_contact_on(t, y, start, zero, post_s * 2.0 / 3.0, m, ContactShape::Ramp, sigma, want)?;
+    let jump = read_contact_on(t, y, start, zero, post_s, m, ContactShape::Jump, sigma, want)?;
     let d_w = shorter.reading.velocity_mm_s - main.reading.velocity_mm_s;
-    let d_s = ramp.reading.velocity_mm_s - main.reading.velocity_mm_s;
+    let d_s = jump.reading.velocity_mm_s - main.reading.velocity_mm_s;
     let mut out = main;
     out.reading.u_mm_s = (main.reading.u_mm_s.powi(2) + (d_w * d_w + d_s * d_s) / 3.0).sqrt();
     Some(out)

@@ -96,6 +96,11 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     // Issue 10: it carries what a façade ensemble draws from, and the study's
     // calibration set draws e_in ~ N(mean, √(sd_tests² + se_fit²)).
     let file = rocklab::ingest::calibration::read(&toml_path).unwrap().calibration;
+    // The tests were made with one pair: their fits agree on it, and the file says so.
+    let agreement = cal.agreement.expect("three tests");
+    println!("{}", agreement.describe());
+    assert!(agreement.share_one_pair, "{}", agreement.describe());
+    assert_eq!(file.joint.as_ref().and_then(|j| j.agreement), Some(agreement));
     let sp = file.spread.clone().expect("[calibration.spread]").spread;
     let inc: Vec<_> = cal.tests.iter().filter(|t| cal.included.contains(&t.id)).collect();
     assert_eq!(sp.n_tests, inc.len());
@@ -356,6 +361,9 @@ fn a_stated_filter_is_replayed() {
     }
     let j = stated.joint.as_ref().expect("a joint fit");
     assert!((j.e_in - 0.85).abs() <= 3.0 * j.se_e_in, "e {:.6} ± {:.6}", j.e_in, j.se_e_in);
+    // One e made every test: the fits agree on it (p = 0.23 when written).
+    let agreement = stated.agreement.expect("four tests");
+    assert!(agreement.share_one_pair, "{}", agreement.describe());
 
     let dir = tempfile::tempdir().unwrap();
     for f in std::fs::read_dir(&src).unwrap() {

@@ -4,7 +4,7 @@
 //! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
 
 use crate::impacts::{extend_late, extend_late_contacts, impact_table, Geometry, ImpactTable};
-use crate::peaks::late::{contact_peaks, CONTACT_POST_S};
+use crate::peaks::late::{contact_peaks, nominal_arc, CONTACT_POST_S};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
 use crate::restitution::{coefficients, uncertainties, Coefficients};
 use crate::wall::{Rocking, Wall};
@@ -113,8 +113,9 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
                 &red.analysis,
                 &red.log.time_s,
                 phys.lever_arm_mm,
-                phys.p_guess,
-                alpha_rad,
+                red.analysis
+                    .small_arc
+                    .unwrap_or_else(|| nominal_arc(phys.p_guess, alpha_rad, phys.lever_arm_mm)),
                 MAX_IMPACT_PEAKS,
                 CONTACT_POST_S,
             );

@@ -386,20 +386,13 @@ fn contact_readings_by_side() {
                 let Ok(r) = t.result.as_ref() else { continue };
                 let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
                 let vt = |k: usize| tt["peaks"].as_array().unwrap().get(k).and_then(|q| q["velocity_mm_s"].as_f64());
-                let p = if std::env::var("CONTACT_P").is_ok() {
-                    r.analysis.p_fit.unwrap_or(p)
+                let lever_mm = t.spec.lever_arm_m * 1000.0;
+                let arc = if std::env::var("CONTACT_NOMINAL").is_ok() {
+                    rocklab::peaks::late::nominal_arc(p, res.campaign.alpha_rad, lever_mm)
                 } else {
-                    p
+                    r.analysis.small_arc.unwrap()
                 };
-                let read = contact_peaks(
-                    &r.analysis,
-                    &r.log.time_s,
-                    t.spec.lever_arm_m * 1000.0,
-                    p,
-                    res.campaign.alpha_rad,
-                    12,
-                    post_ms * 1e-3,
-                );
+                let read = contact_peaks(&r.analysis, &r.log.time_s, lever_mm, arc, 12, post_ms * 1e-3);
                 let mut line = format!("  {} ({}):", t.spec.id, if r.analysis.quality.is_ok() { "ok" } else { "flagged" });
                 let rel: Vec<(usize, Option<f64>, bool, f64)> = read
                     .iter()

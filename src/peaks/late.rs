@@ -282,8 +282,9 @@ fn read_one(inp: &LateInput, y: &[f64], k: usize, start: f64, end_next: f64, wan
 ///
 /// - the free arc on the base (outward half-cycle, paper Eq. 1 about the
 ///   outward toe, linearised near θ = 0: θ'' = p² cos α (θ − tan α)): f =
-///   y_c + A cosh qτ + B sinh qτ with q = p √cos α and y_c = L tan α fixed by the
-///   wall's geometry ([`FreeMotion::Rocking`]; the free-centre form
+///   y_c + A cosh qτ + B sinh qτ with q = p √cos α and y_c = L tan α as the
+///   log's global fit found them ([`super::Analysis::small_arc`]; a real wall is
+///   not its manifest's nominal geometry) ([`FreeMotion::Rocking`]; the free-centre form
 ///   [`FreeMotion::Arc`] is kept for comparison);
 /// - the push into the transverse walls (inward half-cycle, a lossy spring
 ///   contact): θ'' = −ω² (θ − θ_e) − 2λ θ', f spans {1, e^{−λτ} cos ωτ,
@@ -306,7 +307,7 @@ pub enum FreeMotion {
     /// The lossy restraint: θ'' = −ω²(θ − θ_e) − 2λθ', λ and ω in 1/s.
     Restraint { lambda: f64, omega: f64 },
     /// The free arc of the rigid block about its outward toe with its centre
-    /// fixed by the geometry (paper Eq. 1 about the toe, linearised near
+    /// fixed by the wall's fitted geometry (paper Eq. 1 about the toe, linearised near
     /// θ = 0): θ'' = −p² sin(α − θ) ≈ p² cos α (θ − tan α), so in y = Lθ
     /// y'' = q² (y − y_c), q = p √cos α, y_c = L tan α (`rate` q in rad/s,
     /// `centre_mm` y_c). Two columns {cosh qτ, sinh qτ}: the arc's acceleration
@@ -754,11 +755,18 @@ pub struct ContactPeak {
 /// says how much the choice moves it (docs/restitution-law.md).
 pub const CONTACT_POST_S: f64 = 0.02;
 
+/// The free arc of small amplitude from the nominal geometry: rate p √cos α
+/// and centre L tan α (mm), where the log's own fit gives none.
+pub fn nominal_arc(p: f64, alpha_rad: f64, lever_mm: f64) -> (f64, f64) {
+    (p * alpha_rad.cos().sqrt(), lever_mm * alpha_rad.tan())
+}
+
 /// Peaks 1 … `max_peaks − 1` of a one-sided log read with the contact model:
-/// k even ends a free arc on the base ([`FreeMotion::Rocking`], the block's
-/// rate `p` and slenderness `alpha_rad`), k odd a push into the transverse
-/// walls (the test's restraint, [`restraint_of`]).
-pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, p: f64, alpha_rad: f64, max_peaks: usize, post_s: f64) -> Vec<ContactPeak> {
+/// k even ends a free arc on the base ([`FreeMotion::Rocking`] with `arc` =
+/// (rate s⁻¹, centre mm): the global fit's [`super::Analysis::small_arc`], so
+/// that a wall whose geometry is not the manifest's is read with its own), k
+/// odd a push into the transverse walls (the test's restraint, [`restraint_of`]).
+pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f64), max_peaks: usize, post_s: f64) -> Vec<ContactPeak> {
     if t.len() < 3 || t.len() != a.displacement_mm.len() {
         return Vec::new();
     }
@@ -769,8 +777,8 @@ pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, p: f64, alph
     let inward: Vec<(f64, f64)> = (1..c.len()).filter(|k| k % 2 == 1).map(|k| (c[k - 1], c[k])).collect();
     let restraint = restraint_of(t, &y, &inward, post_s, a.noise_mm);
     let arc = FreeMotion::Rocking {
-        rate: p * alpha_rad.cos().sqrt(),
-        centre_mm: lever_mm * alpha_rad.tan(),
+        rate: arc.0,
+        centre_mm: arc.1,
     };
     (1..c.len())
         .map(|k| {

@@ -235,6 +235,9 @@ pub struct Analysis {
     pub contact_phases: bool,
     /// Fitted decay rate γ of the inward arcs (s⁻¹, one-sided).
     pub gamma_fit: Option<f64>,
+    /// The fit's free arc of small amplitude: rate p_s (s⁻¹) and centre A (mm,
+    /// ≈ L tan α), fitted on this log ([`model::Model::small_arc`]); segments only.
+    pub small_arc: Option<(f64, f64)>,
     /// The second estimate of each peak: a local fit of the end of its arc
     /// (velocity, standard uncertainty), where the arc has enough samples.
     pub local_peaks: Vec<Option<(f64, f64)>>,
@@ -417,6 +420,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         peak_covariance: None,
         contact_phases: false,
         gamma_fit: None,
+        small_arc: None,
         local_peaks: Vec::new(),
         methods: Vec::new(),
         response: acquisition::ResponseUsed {
@@ -527,6 +531,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         peak_covariance: cov,
         contact_phases: fit.contacts,
         gamma_fit: fit.model().gamma(),
+        small_arc: Some(fit.model().small_arc()),
         local_peaks: local,
         methods,
         response,

@@ -341,6 +341,14 @@ impl Model {
     /// p_s² = p₀² cos α / cos(α − θ*). Short arcs only see the gravity term
     /// A p² (their curvature at θ = 0), so p and A are not separable there and p
     /// is tied to the release arc's.
+    /// The free arc of the small amplitudes as this fit found it: its rate p_s
+    /// ([`Model::p_small`]) and its centre A (≈ L tan α), mm. The wall's own,
+    /// where the manifest's nominal geometry is not (SPEC: real walls never
+    /// match it).
+    pub fn small_arc(&self) -> (f64, f64) {
+        (self.p_small(), self.q[ix::LN_A].exp())
+    }
+
     pub fn p_small(&self) -> f64 {
         let p0 = self.p();
         if !self.lever.is_finite() {

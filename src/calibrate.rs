@@ -15,6 +15,7 @@
 
 use crate::fit::{least_squares, FitError, FitResult, FitStop};
 use crate::reduction::Reduced;
+use crate::signal::filter::LowPass;
 use crate::solver::impact::ImpactLaw;
 use crate::solver::{simulate_at, Ground, Restraint, RockingModel, Settings};
 use crate::wall::{Rocking, Side, Wall};
@@ -73,6 +74,11 @@ pub struct TestWindow {
     pub x_release_mm: f64,
     pub lever_mm: f64,
     pub t_end: f64,
+    /// The logger's causal low-pass the reduction read this test through
+    /// (stated in the manifest or estimated from the log), if any: the replay
+    /// is seen through it before it is compared with the samples
+    /// ([`through_logger`]).
+    pub filter: Option<LowPass>,
 }
 
 /// The rocking physics shared by the tests of a campaign.
@@ -194,6 +200,7 @@ pub fn window_to(id: &str, r: &Reduced, lever_mm: f64, t_end: f64) -> TestWindow
         x_release_mm: x_rel,
         lever_mm,
         t_end,
+        filter: a.response.filter,
     }
 }
 
@@ -277,8 +284,73 @@ pub fn replay_with(w: &TestWindow, geom: &Geometry, e_in: f64, e_out: f64, law: 
     settings.max_step = 0.05;
     settings.rest_speed = 1e-9;
     settings.max_steps = replay_step_budget(w.t.len());
-    let (_, th) = simulate_at(&model, &ground, w.release_s + nu.release_offset_s(), Some([theta0, 0.0]), &settings, &w.t).ok()?;
-    Some(th.iter().map(|t| z + w.lever_mm * t.sin()).collect())
+    let t_release = w.release_s + nu.release_offset_s();
+    let reading = |th: Vec<f64>| -> Vec<f64> { th.iter().map(|t| z + w.lever_mm * t.sin()).collect() };
+    match w.filter {
+        None => {
+            let (_, th) = simulate_at(&model, &ground, t_release, Some([theta0, 0.0]), &settings, &w.t).ok()?;
+            Some(reading(th))
+        }
+        Some(filter) => {
+            let (nodes, first) = fine_grid(&w.t, t_release);
+            let (_, th) = simulate_at(&model, &ground, t_release, Some([theta0, 0.0]), &settings, &nodes).ok()?;
+            Some(through_logger(&filter, &nodes, &reading(th), w.t.len(), first))
+        }
+    }
+}
+
+/// Steps of the fine grid per sample interval in a replay seen through a
+/// logger's filter. The reading is taken as linear between nodes: the input's
+/// error is at most h²|ẍ|/8 on the arcs and a triangle of area Δv h²/8 at an
+/// impact's kink (Δv the speed jump). With h = Δt/16 at 100 Hz, Δv = 1000 mm/s
+/// and a Bessel low-pass at 10 Hz (impulse response ≤ 30 s⁻¹) that is at most
+/// 0.0015 mm at the output: a twentieth of a 0.03 mm sensor's noise.
+const FINE_STEPS: usize = 16;
+
+/// The nodes of a replay seen through a filter: the release, then every sample
+/// interval from it on cut into [`FINE_STEPS`]; with the index of the first
+/// sample after the release (sample i ≥ first is node (i − first + 1) ×
+/// [`FINE_STEPS`]).
+fn fine_grid(t: &[f64], t_release: f64) -> (Vec<f64>, usize) {
+    let first = t.partition_point(|&v| v <= t_release);
+    let mut nodes = Vec::with_capacity((t.len() - first) * FINE_STEPS + 1);
+    nodes.push(t_release);
+    let mut prev = t_release;
+    for &ti in &t[first..] {
+        let h = (ti - prev) / FINE_STEPS as f64;
+        nodes.extend((1..FINE_STEPS).map(|j| prev + j as f64 * h));
+        nodes.push(ti);
+        prev = ti;
+    }
+    (nodes, first)
+}
+
+/// The replay's reading seen through the logger's causal low-pass (the model
+/// the reducer fits, `peaks::acquisition`): the filter holds the release
+/// reading x₀ in steady state until the release, then is driven exactly
+/// ([`crate::signal::filter::Modal::advance`]) by the reading taken as linear
+/// between the fine nodes. Samples before the release read x₀.
+fn through_logger(filter: &LowPass, nodes: &[f64], x: &[f64], samples: usize, first: usize) -> Vec<f64> {
+    let modal = filter.modal();
+    let mut state = modal.steady_state(x[0]);
+    let mut out = vec![x[0]; first];
+    out.reserve(samples - first);
+    let mut steps = modal.step_coefficients(1.0);
+    let mut h_steps = f64::NAN;
+    for j in 1..nodes.len() {
+        let h = nodes[j] - nodes[j - 1];
+        if (h - h_steps).abs() > 1e-9 * h || h_steps.is_nan() {
+            steps = modal.step_coefficients(h);
+            h_steps = h;
+        }
+        if h > 0.0 {
+            modal.advance(&mut state, &steps, [x[j - 1], (x[j] - x[j - 1]) / h, 0.0, 0.0]);
+        }
+        if j % FINE_STEPS == 0 {
+            out.push(modal.output(&state));
+        }
+    }
+    out
 }
 
 /// Integration steps a replay of `samples` log samples may take before it is
@@ -483,6 +555,79 @@ pub fn fit_joint(ws: &[TestWindow], geom: &Geometry, starts: &[TestFit], single_
     })
 }
 
+/// Whether the included tests' fits agree on one pair (e_in, e_out), which the
+/// joint fit assumes: per coefficient, χ² = Σ ((e_i − ē)/se_i)² about the
+/// inverse-variance mean ē on n − 1 degrees of freedom, and the smaller of the
+/// two p-values. Where the tests differ beyond their fits' standard errors, the
+/// joint fit's interval measures none of them: the campaign's coefficient is the
+/// mean, with its test-to-test spread ([`Spread`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Agreement {
+    pub chi2_e_in: f64,
+    pub chi2_e_out: f64,
+    pub dof: usize,
+    pub p_value: f64,
+    /// p ≥ [`AGREEMENT_LEVEL`].
+    pub share_one_pair: bool,
+}
+
+/// The level below which the tests are taken not to share one pair. Strict
+/// (10⁻³, not 0.05) because each fit's standard error comes from residuals that
+/// are correlated in time, which makes it small: on a campaign made outside
+/// rocklab with one e (`fixtures/campaigns/bessel-replay`) p = 0.23; on every
+/// shipped campaign of walls or of per-impact coefficients p < 10⁻¹⁷.
+pub const AGREEMENT_LEVEL: f64 = 1e-3;
+
+/// [`Agreement`] of the fits (None with fewer than two).
+pub fn agreement(fits: &[TestFit]) -> Option<Agreement> {
+    if fits.len() < 2 {
+        return None;
+    }
+    let chi2 = |e: fn(&TestFit) -> f64, se: fn(&TestFit) -> f64| {
+        let w: Vec<f64> = fits.iter().map(|f| se(f).powi(-2)).collect();
+        let mean = fits.iter().zip(&w).map(|(f, w)| w * e(f)).sum::<f64>() / w.iter().sum::<f64>();
+        fits.iter().map(|f| ((e(f) - mean) / se(f)).powi(2)).sum::<f64>()
+    };
+    let chi2_e_in = chi2(|f| f.e_in, |f| f.se_e_in);
+    let chi2_e_out = chi2(|f| f.e_out, |f| f.se_e_out);
+    let dof = fits.len() - 1;
+    let p_value = crate::stats::chi2_sf(chi2_e_in, dof).min(crate::stats::chi2_sf(chi2_e_out, dof));
+    // A fit with a zero standard error makes χ² infinite or NaN: no agreement vouched for.
+    let p_value = if p_value.is_nan() { 0.0 } else { p_value };
+    Some(Agreement {
+        chi2_e_in,
+        chi2_e_out,
+        dof,
+        p_value,
+        share_one_pair: p_value >= AGREEMENT_LEVEL,
+    })
+}
+
+impl Agreement {
+    /// "The tests do not share one pair (χ² of the per-test values = …, p =
+    /// 0.00): …", or that they agree.
+    pub fn describe(&self) -> String {
+        let chi2 = if self.chi2_e_in == self.chi2_e_out {
+            format!("{:.1}", self.chi2_e_in)
+        } else {
+            format!("{:.1} (e_in) and {:.1} (e_out)", self.chi2_e_in, self.chi2_e_out)
+        };
+        let p = if self.p_value < AGREEMENT_LEVEL {
+            format!("p < {AGREEMENT_LEVEL}")
+        } else {
+            format!("p = {:.2}", self.p_value)
+        };
+        let stat = format!("χ² of the per-test values = {chi2} on {} degrees of freedom, {p}", self.dof);
+        if self.share_one_pair {
+            format!("The tests agree on one pair ({stat})")
+        } else {
+            format!(
+                "The tests do not share one pair ({stat}): the joint fit's interval assumes they do and measures none of them; the calibration is the means, with the test-to-test spread"
+            )
+        }
+    }
+}
+
 /// The campaign's calibration.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Calibration {
@@ -495,6 +640,8 @@ pub struct Calibration {
     pub r_in: f64,
     pub r_out: f64,
     pub joint: Option<JointFit>,
+    /// Whether the included tests agree on the one pair the joint fit assumes.
+    pub agreement: Option<Agreement>,
     /// Why there is no joint fit, when there are included tests but no joint fit.
     #[serde(skip)]
     pub joint_failure: Option<FitError>,
@@ -620,6 +767,7 @@ pub fn calibrate(c: &CampaignInput, n_impacts: usize) -> Calibration {
         e_out,
         r_in: e_in / e_housner,
         r_out: e_out / e_housner,
+        agreement: agreement(&inc_fits),
         joint_failure: joint.clone().and_then(Result::err),
         joint: joint.and_then(Result::ok),
         tests,
@@ -724,6 +872,10 @@ pub struct JointValues {
     pub se_e_in: f64,
     pub se_e_out: f64,
     pub rms_mm: f64,
+    /// Whether the tests share the one pair this fit assumes (absent in files
+    /// written before it was checked).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub agreement: Option<Agreement>,
 }
 
 impl CalibrationFile {
@@ -748,6 +900,7 @@ impl CalibrationFile {
                     se_e_in: j.se_e_in,
                     se_e_out: j.se_e_out,
                     rms_mm: j.rms_mm,
+                    agreement: c.agreement,
                 }),
             },
         }
@@ -768,10 +921,14 @@ pub fn to_toml(c: &Calibration) -> Result<String, CalibrationFileError> {
         });
     }
     let header = format!(
-        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}{}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them.\n",
+        "# Written by rocklab calibrate. e_in/e_out: means of the per-test fits over the\n# included tests ({}{}); [calibration.spread]: their test-to-test spread and the\n# fits' standard errors (what a façade ensemble draws from). Each test: unweighted\n# least squares on the displacement (mm) over the window of its first impacts,\n# nuisance parameters free (release time, zero, p² factor{}).\n# [calibration.joint]: one fit over all of them{}.\n",
         c.included.join(", "),
         if c.left_out.is_empty() { String::new() } else { format!("; left out: {}", c.left_out_short()) },
         if c.rocking == Rocking::OneSided { ", inward spring" } else { "" },
+        match c.agreement {
+            Some(a) if !a.share_one_pair => " (the tests do not share one pair: its interval\n# measures none of them; use the means and [calibration.spread])",
+            _ => "",
+        },
     );
     Ok(header + &toml::to_string(&CalibrationFile::of(c))?)
 }
@@ -806,6 +963,7 @@ mod tests {
             x_release_mm: 3000.0,
             lever_mm: 2330.0,
             t_end: 2.0,
+            filter: None,
         };
         let e = fit_test(&w, &geom, false).unwrap_err();
         assert_eq!(e, TestFailure::NoStart);

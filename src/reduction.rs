@@ -114,6 +114,7 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
                 &red.log.time_s,
                 phys.lever_arm_mm,
                 phys.p_guess,
+                alpha_rad,
                 MAX_IMPACT_PEAKS,
                 CONTACT_POST_S,
             );

@@ -96,6 +96,11 @@ fn recovers_constant_coefficients_from_synthetic_campaign() {
     // Issue 10: it carries what a façade ensemble draws from, and the study's
     // calibration set draws e_in ~ N(mean, √(sd_tests² + se_fit²)).
     let file = rocklab::ingest::calibration::read(&toml_path).unwrap().calibration;
+    // The tests were made with one pair: their fits agree on it, and the file says so.
+    let agreement = cal.agreement.expect("three tests");
+    println!("{}", agreement.describe());
+    assert!(agreement.share_one_pair, "{}", agreement.describe());
+    assert_eq!(file.joint.as_ref().and_then(|j| j.agreement), Some(agreement));
     let sp = file.spread.clone().expect("[calibration.spread]").spread;
     let inc: Vec<_> = cal.tests.iter().filter(|t| cal.included.contains(&t.id)).collect();
     assert_eq!(sp.n_tests, inc.len());
@@ -238,6 +243,7 @@ fn law_test(
         x_release_mm: x0,
         lever_mm: lever,
         t_end,
+        filter: None,
     };
     let geom = rocklab::calibrate::Geometry {
         alpha,
@@ -328,4 +334,61 @@ fn a_suspect_test_is_left_out_of_the_means() {
     let a = cal.tests.iter().find(|t| t.id == "a").unwrap();
     assert_eq!((cal.e_in, cal.e_out), (a.e_in, a.e_out));
     assert!(rocklab::calibrate::to_toml(&cal).unwrap().contains("left out: b (suspect)"));
+}
+
+/// The logger's filter is part of the replay: `fixtures/campaigns/bessel-replay`
+/// was made outside rocklab (`tools/filtered_replay_campaign.py`: scipy's rigid
+/// block with e = 0.85, seen through scipy's 4th-order Bessel at 0.10 fs, stated
+/// in the manifest, noise σ = 0.03 mm). Replayed through the stated filter, every
+/// fit's residuals are at the noise (RMS ≤ 1.15 σ; 0.030–0.031 mm measured) and
+/// the joint e is within 3 standard errors of 0.85 (0.849993 ± 0.000004 when
+/// written). The same logs declared unfiltered (`filter = "none"`: what the
+/// replay did before it saw the filter) leave residuals above 3 σ (0.097–0.111
+/// mm) and a joint e 0.0004 low, some 40 standard errors: a bias its interval
+/// does not hold.
+#[test]
+fn a_stated_filter_is_replayed() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/bessel-replay");
+    let calibrate_as = |manifest: &Path| {
+        let res = reduce_campaign(Campaign::load(manifest).unwrap(), PeakOptions::default());
+        calibrate(&res.calibration_input(), 6)
+    };
+    const SIGMA: f64 = 0.03;
+    let stated = calibrate_as(&src.join("campaign.toml"));
+    assert_eq!(stated.included.len(), 4, "{:?}", stated.left_out);
+    for t in &stated.tests {
+        assert!(t.rms_mm <= 1.15 * SIGMA, "{}: RMS {:.4} mm", t.id, t.rms_mm);
+    }
+    let j = stated.joint.as_ref().expect("a joint fit");
+    assert!((j.e_in - 0.85).abs() <= 3.0 * j.se_e_in, "e {:.6} ± {:.6}", j.e_in, j.se_e_in);
+    // One e made every test: the fits agree on it (p = 0.23 when written).
+    let agreement = stated.agreement.expect("four tests");
+    assert!(agreement.share_one_pair, "{}", agreement.describe());
+
+    let dir = tempfile::tempdir().unwrap();
+    for f in std::fs::read_dir(&src).unwrap() {
+        let p = f.unwrap().path();
+        if p.extension().is_some_and(|e| e == "csv") {
+            std::fs::copy(&p, dir.path().join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let text = std::fs::read_to_string(src.join("campaign.toml")).unwrap();
+    let none: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("acquisition") {
+                "acquisition = { filter = \"none\" }"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.path().join("campaign.toml"), none).unwrap();
+    let unfiltered = calibrate_as(&dir.path().join("campaign.toml"));
+    for t in &unfiltered.tests {
+        assert!(t.rms_mm > 3.0 * SIGMA, "{}: RMS {:.4} mm: the filter no longer shows", t.id, t.rms_mm);
+    }
+    let j = unfiltered.joint.as_ref().expect("a joint fit");
+    assert!((j.e_in - 0.85).abs() > 10.0 * j.se_e_in, "e {:.6} ± {:.6}", j.e_in, j.se_e_in);
 }

@@ -603,6 +603,16 @@ fn calibrate_then_simulate_with_the_calibration() {
         assert_eq!(t["e_in"], t["e_out"]);
     }
     assert!(out.join("plots/coefficients.png").is_file());
+    // The demo's e change impact by impact, so its tests do not share one pair:
+    // summary.json, calibration.toml and the terminal say the joint interval
+    // measures none of them.
+    assert_eq!(c["joint_agreement"]["share_one_pair"], false, "{}", c["joint_agreement"]);
+    let toml = std::fs::read_to_string(out.join("calibration.toml")).unwrap();
+    assert!(
+        toml.contains("the tests do not share one pair") && toml.contains("share_one_pair = false"),
+        "{toml}"
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("The tests do not share one pair"));
     let sim = dir.path().join("sim");
     let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
         .args(["simulate", "--block"])

@@ -391,7 +391,15 @@ fn contact_readings_by_side() {
                 } else {
                     p
                 };
-                let read = contact_peaks(&r.analysis, &r.log.time_s, t.spec.lever_arm_m * 1000.0, p, 12, post_ms * 1e-3);
+                let read = contact_peaks(
+                    &r.analysis,
+                    &r.log.time_s,
+                    t.spec.lever_arm_m * 1000.0,
+                    p,
+                    res.campaign.alpha_rad,
+                    12,
+                    post_ms * 1e-3,
+                );
                 let mut line = format!("  {} ({}):", t.spec.id, if r.analysis.quality.is_ok() { "ok" } else { "flagged" });
                 let rel: Vec<(usize, Option<f64>, bool, f64)> = read
                     .iter()

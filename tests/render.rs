@@ -151,6 +151,7 @@ fn calibration() -> Calibration {
         r_in: 0.339,
         r_out: 0.678,
         joint: None,
+        agreement: None,
         joint_failure: None,
         tests: vec![fit("150_1", 0.312, 0.637), fit("150_2", 0.357, 0.852)],
         per_impact: vec![

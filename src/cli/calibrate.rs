@@ -61,6 +61,9 @@ pub fn calibrate_and_write(res: &CampaignResult, sources: &Sources, out: &Path, 
             j.rms_mm
         ));
     }
+    if let Some(a) = &cal.agreement {
+        say(&format!("joint fit: {}", a.describe()));
+    }
     for n in &law.notes {
         say(&format!("law by replay, {n}"));
     }

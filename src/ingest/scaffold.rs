@@ -399,6 +399,7 @@ pub fn manifest_text(name: &str, logs: &[LogSurvey], skipped: &[Skipped]) -> Str
         delimiter_toml(first.delimiter),
         decimal_toml(first.decimal)
     ));
+    o.push_str(ACQUISITION_HINT);
     if !first.metadata.is_empty() {
         o.push_str(&format!("\n# The header of {}:\n", first.file));
         first.metadata.iter().take(12).for_each(|l| o.push_str(&format!("#   {l}\n")));
@@ -409,6 +410,18 @@ pub fn manifest_text(name: &str, logs: &[LogSurvey], skipped: &[Skipped]) -> Str
     push_skipped(&mut o, skipped);
     o
 }
+
+/// The logger's filter, commented out: `init` cannot read it from a log, and
+/// stating it is what makes it cost no accuracy (SPEC `[acquisition]`).
+const ACQUISITION_HINT: &str = "
+# The data logger's low-pass on the displacement channel, if you know it (its
+# datasheet or settings): a stated filter is modelled exactly; without one, each
+# log is searched for a filter's signature and the report says what was assumed.
+# [acquisition]
+# filter = \"bessel\"     # \"bessel\" | \"butterworth\" | \"none\" | \"unknown\"
+# order = 4             # 2–8
+# cutoff_hz = 50.0      # the −3 dB frequency
+";
 
 /// One `[[test]]`: id, file, what differs from the first log, and a comment with
 /// its rate, rows and span.
@@ -589,5 +602,27 @@ mod tests {
             "{e}"
         );
         assert!(check_filled(&text.replace(&fill(SENSOR_HEIGHT), "2.5"), Path::new("m.toml")).is_ok());
+    }
+
+    /// The logger's filter is offered commented out; uncommented as it stands it is
+    /// the SPEC's `[acquisition]` table (a stated Bessel-4 at 50 Hz), ahead of the tests.
+    #[test]
+    fn the_draft_offers_the_loggers_filter() {
+        let s = survey_log("w_1.txt", LOG).unwrap();
+        let text = manifest_text("w", &[s], &[]);
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        assert!(!table.contains_key("acquisition"), "stated without the lab saying so");
+        let hint: Vec<&str> = ACQUISITION_HINT
+            .lines()
+            .filter_map(|l| l.strip_prefix("# "))
+            .skip_while(|l| !l.starts_with('['))
+            .collect();
+        let stated: toml::Table = toml::from_str(&hint.join("\n")).unwrap();
+        let a = stated["acquisition"].as_table().unwrap();
+        assert_eq!(
+            (a["filter"].as_str(), a["order"].as_integer(), a["cutoff_hz"].as_float()),
+            (Some("bessel"), Some(4), Some(50.0))
+        );
+        assert!(text.find("# [acquisition]").unwrap() < text.find("[[test]]").unwrap());
     }
 }

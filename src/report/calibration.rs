@@ -142,6 +142,9 @@ fn calibration_html(cal: &Calibration, law: Option<&LawReplay>, n: usize, figs: 
             j.iterations,
             j.stop
         ));
+        if let Some(a) = &cal.agreement {
+            s.push_str(&format!("<p>{}.</p>\n", escape(&a.describe())));
+        }
     }
     s.push_str(&to_html(&calibration_table(cal)));
     s.push_str(&to_html(&per_impact_table(cal)));

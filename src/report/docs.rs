@@ -97,6 +97,10 @@ struct CalibrationDoc<'a> {
     /// Every test the means leave out, with why (suspect tests included).
     left_out: Vec<super::summary::LeftOut<'a>>,
     joint: &'a Option<JointFit>,
+    /// Whether the included tests share the one pair the joint fit assumes
+    /// ([`crate::calibrate::Agreement`]); absent with fewer than two tests.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    joint_agreement: Option<crate::calibrate::Agreement>,
     tests: &'a [TestFit],
     per_impact: Vec<PerImpact<'a>>,
     failed: Vec<Failure<'a>>,
@@ -120,6 +124,7 @@ pub fn calibration_summary(cal: &Calibration, law: Option<&crate::law_replay::La
         included: &cal.included,
         left_out: cal.left_out.iter().map(|(id, why)| super::summary::LeftOut { id, why }).collect(),
         joint: &cal.joint,
+        joint_agreement: cal.agreement,
         tests: &cal.tests,
         per_impact: cal.per_impact.iter().map(|(id, i, o)| PerImpact { id, inward: i, outward: o }).collect(),
         failed: cal.failed.iter().map(|(id, e)| Failure { id, error: e }).collect(),

@@ -445,6 +445,8 @@ fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
             r.analysis.quality.describe()
         );
         if std::env::var("ENGINE_DETAIL").is_ok() {
+            let values: Vec<String> = errors_pp(&v, e_h, tt).iter().map(|(k, e)| format!("{k} {e:+.2}")).collect();
+            println!("    values (pp): {}", values.join(", "));
             print_readings(&t.spec.id, r, t.spec.lever_arm_m * 1000.0, &true_v);
         }
         out.push((t.spec.id.clone(), worst, r.analysis.quality.is_ok(), z));

@@ -60,6 +60,11 @@ pub struct ImpactTable {
     /// The analysis' impacts (time, side entered, signed speeds) these come from: one
     /// more than `impacts` (the last impact's speed after is not a fitted peak).
     pub raw: Vec<Impact>,
+    /// Why the list ends where it does, where the late readings extended it
+    /// ([`extend_late`], [`extend_late_contacts`]): the first impact not reported
+    /// and the reason (summary.json `impacts_end`, report.html). An impact the
+    /// readings cannot vouch for is not a number in the table; this says why.
+    pub end: Option<String>,
 }
 
 /// What the amplitude needs besides the analysis: the log's time axis, the sensor's
@@ -104,6 +109,7 @@ pub fn impact_table(a: &Analysis, geo: &Geometry, e_h: f64) -> ImpactTable {
         impacts,
         r_cov,
         raw: a.impacts.iter().take(v.len()).copied().collect(),
+        end: None,
     }
 }
 
@@ -149,12 +155,29 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
             &[ReadingMethod::LocalExtreme]
         };
         let Some((a, b)) = methods.iter().find_map(|&m| Some((w[0].by(m)?, w[1].by(m)?))) else {
+            table.end = Some(format!(
+                "impact {}: peaks {} and {} are not read alike ({}), and a ratio of unlike readings carries their different biases",
+                w[0].k,
+                w[0].k,
+                w[1].k,
+                if two_sided {
+                    "both resolved extremes or both kinks"
+                } else {
+                    "both resolved extremes"
+                }
+            ));
             break;
         };
-        let Some(coefficient) = late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_LATE_R_U) else {
-            break;
-        };
-        added.push((coefficient, a, b));
+        match late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_LATE_R_U) {
+            Ok(coefficient) => added.push((coefficient, a, b)),
+            Err(why) => {
+                table.end = Some(why);
+                break;
+            }
+        }
+    }
+    if table.end.is_none() {
+        table.end = Some(no_later_peak(table.impacts.len() + added.len()));
     }
     let crossings: Vec<f64> = late.iter().map(|p| p.crossing_s).collect();
     append_late(table, &added, &crossings);
@@ -176,26 +199,49 @@ pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h:
     let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
     for w in peaks.windows(2) {
         let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
-        let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else { break };
-        let Some(c) = late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_CONTACT_R_U) else {
+        let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else {
+            let unread = if read(&w[0]).is_none() { w[0].k } else { w[1].k };
+            table.end = Some(format!(
+                "impact {}: peak {unread} has no reading of the contact model that fits the samples to the noise",
+                w[0].k
+            ));
             break;
         };
-        added.push((c, a, b));
+        match late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_CONTACT_R_U) {
+            Ok(c) => added.push((c, a, b)),
+            Err(why) => {
+                table.end = Some(why);
+                break;
+            }
+        }
+    }
+    if table.end.is_none() {
+        table.end = Some(no_later_peak(table.impacts.len() + added.len()));
     }
     let crossings: Vec<f64> = peaks.iter().map(|p| p.crossing_s).collect();
     append_late(table, &added, &crossings);
 }
 
+/// The end of a list that ran out of read peaks: impact k is the first without.
+fn no_later_peak(k: usize) -> String {
+    format!("impact {k}: the log reads no later peak (the half-cycles after it are under 20 × the noise, or their peaks are not read)")
+}
+
 /// Impact k's coefficient from the readings `a` and `b` of peaks k and k + 1,
-/// None where e > 1 or u(r) is above `cap` or not finite.
-fn late_coefficient(k: usize, apex_mm: f64, a: Reading, b: Reading, e_h: f64, geo: &Geometry, cap: f64) -> Option<ImpactCoefficient> {
+/// or why not: e > 1, or u(r) above `cap` or not finite.
+fn late_coefficient(k: usize, apex_mm: f64, a: Reading, b: Reading, e_h: f64, geo: &Geometry, cap: f64) -> Result<ImpactCoefficient, String> {
     let e = (b.velocity_mm_s / a.velocity_mm_s).abs();
     let r = e / e_h;
     let r_u = r * ((a.u_mm_s / a.velocity_mm_s).powi(2) + (b.u_mm_s / b.velocity_mm_s).powi(2)).sqrt();
-    if e > 1.0 || !r_u.is_finite() || r_u > cap {
-        return None;
+    if e > 1.0 {
+        return Err(format!(
+            "impact {k}: its readings give e = {e:.3} > 1 (an impact cannot return more speed than it took): not vouched for"
+        ));
     }
-    Some(ImpactCoefficient {
+    if !r_u.is_finite() || r_u > cap {
+        return Err(format!("impact {k}: u(r) = {r_u:.3} is above {cap} (r = {r:.3}): not vouched for"));
+    }
+    Ok(ImpactCoefficient {
         k,
         side: if k.is_multiple_of(2) { Side::Inward } else { Side::Outward },
         amplitude_over_alpha: (apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / geo.alpha_rad,
@@ -360,6 +406,11 @@ mod tests {
         assert_eq!(cov[0][1], 0.0, "impacts 0 and 1 use different readings of peak 1");
         assert!(cov[1][2] < 0.0, "impacts 1 and 2 share the kink reading of peak 2");
         assert_eq!(two.raw.len(), 4);
+        assert!(
+            two.end.as_deref().unwrap().starts_with("impact 3: peaks 3 and 4 are not read alike"),
+            "{:?}",
+            two.end
+        );
         let mut one = ImpactTable::default();
         extend_late(&mut one, &peaks, 1.0, &geo, false);
         assert_eq!(one.impacts.len(), 1, "one-sided: resolved contacts only");
@@ -427,7 +478,7 @@ mod tests {
         let mut table = ImpactTable {
             impacts: vec![impact_stub(0)],
             r_cov: Some(vec![vec![1e-4]]),
-            raw: Vec::new(),
+            ..ImpactTable::default()
         };
         table.impacts.push(impact_stub(1));
         table.r_cov = Some(vec![vec![1e-4, 0.0], vec![0.0, 1e-4]]);
@@ -436,6 +487,10 @@ mod tests {
         assert_eq!(ks, [0, 1, 2], "impact 2 from peaks 2 and 3; peak 4 does not fit");
         assert!((table.impacts[2].r - 70.0 / 80.0).abs() < 1e-12);
         assert_eq!(table.impacts[2].side, Side::Inward);
+        assert_eq!(
+            table.end.as_deref(),
+            Some("impact 3: peak 4 has no reading of the contact model that fits the samples to the noise")
+        );
         // Starting past the table: nothing added.
         let mut short = ImpactTable::default();
         extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo);

@@ -510,6 +510,7 @@ mod tests {
             impacts,
             r_cov: Some(cov),
             raw: Vec::new(),
+            end: None,
         }
     }
 

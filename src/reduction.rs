@@ -122,6 +122,13 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
             extend_late_contacts(&mut table, &contacts, e_housner, &geo);
         }
     }
+    if table.end.is_some() && table.impacts.len() + 1 >= MAX_IMPACT_PEAKS {
+        table.end = Some(format!(
+            "impact {}: not read: the readings stop at {MAX_IMPACT_PEAKS} peaks ({} impacts)",
+            table.impacts.len(),
+            MAX_IMPACT_PEAKS - 1
+        ));
+    }
     red.impact_peaks = table.impacts.len() + 1;
     red.impacts = table;
 }

@@ -286,6 +286,7 @@ fn one_sided_demo_keeps_a_constant_law() {
                 impacts: keep.iter().map(|&i| table.impacts[i]).collect(),
                 r_cov: Some(keep.iter().map(|&i| keep.iter().map(|&j| cov[i][j]).collect()).collect()),
                 raw: Vec::new(),
+                end: None,
             };
             (t.spec.id.clone(), sub)
         })
@@ -480,6 +481,7 @@ fn truth_tables(listed: &[Listed]) -> Vec<(String, rocklab::impacts::ImpactTable
                     impacts,
                     r_cov: Some(cov),
                     raw: Vec::new(),
+                    end: None,
                 },
             )
         })
@@ -798,6 +800,9 @@ fn one_sided_readings_do_not_lean_on_the_nominal_geometry() {
         c.tests.retain(|t| t.id == "P1_150_2");
         let res = reduce_campaign(c, PeakOptions::default());
         let r = res.tests[0].result.as_ref().unwrap().clone();
+        // Where the list ends is said, naming the first impact not reported.
+        let end = r.impacts.end.clone().expect("why the impacts end");
+        assert!(end.starts_with(&format!("impact {}:", r.impacts.impacts.len())), "{end}");
         (res.campaign.alpha_rad, r.impacts.impacts.iter().map(|i| (i.k, i.e)).collect::<Vec<_>>())
     };
     let (alpha, nominal) = reduced(&text);

@@ -177,6 +177,7 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         s.push_str(&format!("<li>{}</li>\n", escape(n)));
     }
     s.push_str("</ul>\n");
+    s.push_str(&impacts_end_list(res));
     if let Some(f) = figure {
         s.push_str(&format!(
             "<figure>{}<figcaption>r = e/e_H of every impact against the amplitude of the half-cycle it ends, by test; the law with its ±1 u band and the constant for comparison.</figcaption></figure>\n",
@@ -184,6 +185,32 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         ));
     }
     s
+}
+
+/// Where each test's list of impacts ends and why (tests with status ok whose
+/// late readings extended it), as a list for report.html; empty if none.
+fn impacts_end_list(res: &CampaignResult) -> String {
+    let items: Vec<String> = res
+        .tests
+        .iter()
+        .filter_map(|t| {
+            let r = t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok())?;
+            let end = r.impacts.end.as_deref()?;
+            Some(format!(
+                "<li>{}: {} reported; {}</li>\n",
+                escape(&t.spec.id),
+                r.impacts.impacts.len(),
+                escape(end)
+            ))
+        })
+        .collect();
+    if items.is_empty() {
+        return String::new();
+    }
+    format!(
+        "<p>Where each test's impacts end (an impact the readings cannot vouch for is not in the table):</p>\n<ul>\n{}</ul>\n",
+        items.concat()
+    )
 }
 
 /// Adds impacts.csv and the law's plot to `files`; returns the report section.

@@ -40,6 +40,10 @@ struct Reduction<'a> {
     u: Option<Uncertainties<'a>>,
     release_time_s: f64,
     impacts: Vec<ImpactDoc<'a>>,
+    /// Why `impacts` ends where it does (the first impact not reported and the
+    /// reason), where the late readings extended it ([`ImpactTable::end`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    impacts_end: Option<&'a str>,
     /// The logger's filter the model was seen through: stated, estimated, or
     /// none (issue #18).
     acquisition: &'a crate::peaks::acquisition::ResponseUsed,
@@ -156,6 +160,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 u: r.uncertainty.as_ref().map(Uncertainties),
                 release_time_s: r.analysis.release_time_s,
                 impacts: impact_docs(&r.impacts),
+                impacts_end: r.impacts.end.as_deref(),
                 acquisition: &r.analysis.response,
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))

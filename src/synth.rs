@@ -552,6 +552,9 @@ pub struct Scored {
     pub worst_pp: Result<f64, ScoreError>,
     /// The quality the estimator claimed ("ok", "suspect: …").
     pub status: String,
+    /// Why an estimated logger filter was dropped for the contacts' rounding,
+    /// if it was (`Analysis::acquisition_note`).
+    pub acquisition_note: Option<String>,
 }
 
 /// Reduce a synthetic log with the default estimator (the geometry as a lab would
@@ -578,6 +581,7 @@ pub fn score_with(s: &Synthetic, opts: &crate::peaks::PeakOptions) -> Scored {
     let truth: Vec<f64> = s.peaks.iter().take(6).map(|p| p.1).collect();
     let tc = coefficients(&truth, e_h).expect("six true peaks");
     let res = analyse(&s.t, &s.x_mm, &phys, opts);
+    let acquisition_note = res.as_ref().ok().and_then(|a| a.acquisition_note.clone());
     let (worst_pp, status) = match res {
         Err(e) => (Err(ScoreError::Peaks(e)), "error".to_string()),
         Ok(a) => {
@@ -605,6 +609,7 @@ pub fn score_with(s: &Synthetic, opts: &crate::peaks::PeakOptions) -> Scored {
         spec: spec.clone(),
         worst_pp,
         status,
+        acquisition_note,
     }
 }
 

@@ -723,8 +723,10 @@ pub struct Rivals<'a> {
 /// against the contacts' signature ([`rounding_trend`], [`Trend::widens`]):
 /// where its rounding widens over the later impacts, the model chosen without
 /// it stands. Returns the estimate and the peaks of the fits at
-/// f_c e^(±u) (their spread is a term of u).
-pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Option<(Estimate, Vec<Vec<f64>>)> {
+/// f_c e^(±u) (their spread is a term of u); or no estimate, with why where a
+/// filter was estimated and then dropped for the contacts' signature (the
+/// report says so, rather than that no filter was seen).
+pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Result<(Estimate, Vec<Vec<f64>>), Option<String>> {
     let plain = rivals.plain;
     let (n, sigma2) = (tw.len() as f64, sigma.powi(2).max(1e-12));
     let mut found: Vec<Estimate> = [Generic::Bessel4, Generic::Butterworth4, Generic::Fir64]
@@ -743,7 +745,7 @@ pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Op
         .collect();
     found.sort_by(|a, b| a.fitted.fit.cost.total_cmp(&b.fitted.fit.cost));
     let mut found = found.into_iter();
-    let mut est = found.next()?;
+    let mut est = found.next().ok_or(None)?;
     let m = plain.model.m();
     let peaks_of = |f: &Fitted| -> Vec<f64> { (0..m).map(|k| f.model.peak(k).1).collect() };
     let close = |f: &Fitted| f.fit.cost - est.fitted.fit.cost < 2.0 * n.ln() * sigma2;
@@ -761,12 +763,15 @@ pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Op
     let bic_filter = est.fitted.fit.cost / sigma2 + n.ln();
     let bic_chosen = rivals.chosen.fit.cost / sigma2 + rivals.penalty;
     if bic_filter >= bic_chosen {
-        return None;
+        return Err(None);
     }
     est.trend = rounding_trend(&est, tw, yw, dt, sigma);
-    if est.trend.is_some_and(|t| t.widens(n)) {
+    if let Some(t) = est.trend.filter(|t| t.widens(n)) {
         // The rounding is the wall's contacts': the model chosen without a filter stands.
-        return None;
+        return Err(Some(format!(
+            "a low-pass ({:?}, {:.1} Hz) fits the rounding of the impacts, but the later impacts are rounded more widely ({:.1} Hz), as by the wall's compliant contacts, not by a logger's filter: no filter modelled",
+            est.kind, est.cutoff_hz, t.late_hz
+        )));
     }
     let u = est.u_ln_fc.unwrap_or(0.5).min(0.5);
     let spread: Vec<Vec<f64>> = [-u, u]
@@ -774,7 +779,7 @@ pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Op
         .filter_map(|d| fit_through(&est.fitted.model, est.kind, est.cutoff_hz * d.exp(), dt, tw, yw, 40))
         .map(|f| peaks_of(&f))
         .collect();
-    Some((est, spread))
+    Ok((est, spread))
 }
 
 /// The largest difference between two sets of peaks in the ratio of

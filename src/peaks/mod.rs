@@ -246,6 +246,10 @@ pub struct Analysis {
     /// The logger's filter the model was seen through, and its source
     /// ([`acquisition`]).
     pub response: acquisition::ResponseUsed,
+    /// Where an unstated filter was estimated and then dropped because the
+    /// rounding widens as the wall slows (its contacts'), why: the report says
+    /// so beside "not detected".
+    pub acquisition_note: Option<String>,
 }
 
 pub use local::ReadingMethod;
@@ -428,6 +432,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
             filter: None,
             fir_cutoff_hz: None,
         },
+        acquisition_note: None,
     }
 }
 
@@ -535,5 +540,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         local_peaks: local,
         methods,
         response,
+        acquisition_note: fit.filter_dropped.clone(),
     })
 }

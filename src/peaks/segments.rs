@@ -46,6 +46,9 @@ pub struct SegmentFit {
     /// An unstated filter found and estimated, and the peaks of the fits at its
     /// cut-off ± one standard uncertainty (the spread carried into u).
     pub estimated: Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>,
+    /// Where an unstated filter was estimated and then dropped for the wall's
+    /// contacts' signature, why ([`super::acquisition::rival`]).
+    pub filter_dropped: Option<String>,
 }
 
 /// Inputs of the fit.
@@ -140,7 +143,10 @@ impl SegmentFit {
             penalty,
             contacts: best_contacts.as_ref(),
         };
-        let estimated = rival_filter(inp.estimate_filter && misses, &rivals, &tw, &yw, inp.sigma);
+        let (estimated, filter_dropped) = match rival_filter(inp.estimate_filter && misses, &rivals, &tw, &yw, inp.sigma) {
+            Ok(found) => (Some(found), None),
+            Err(why) => (None, why),
+        };
         if let Some((e, _)) = &estimated {
             (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
         }
@@ -155,6 +161,7 @@ impl SegmentFit {
             outliers,
             alternative,
             estimated,
+            filter_dropped,
         })
     }
 
@@ -220,10 +227,13 @@ impl SegmentFit {
 
 /// Where `look` (no filter stated, the plain fit misses the samples around its
 /// impacts): an estimated low-pass, if it beats `chosen` ([`super::acquisition::rival`]).
-type Rival = Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>;
+type Rival = Result<(super::acquisition::Estimate, Vec<Vec<f64>>), Option<String>>;
 fn rival_filter(look: bool, rivals: &super::acquisition::Rivals, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
+    if !look {
+        return Err(None);
+    }
     let dt = (tw[tw.len() - 1] - tw[0]) / (tw.len() - 1) as f64;
-    look.then(|| super::acquisition::rival(rivals, tw, yw, dt, sigma)).flatten()
+    super::acquisition::rival(rivals, tw, yw, dt, sigma)
 }
 
 /// Isolated spikes the spike filter missed: a spike next to an impact, where the

@@ -296,7 +296,10 @@ fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
                 ]);
                 notes.push(vec![
                     t.spec.id.clone(),
-                    format!("data logger's filter: {}", r.analysis.response.describe()),
+                    match &r.analysis.acquisition_note {
+                        Some(why) => format!("data logger's filter: {} ({why})", r.analysis.response.describe()),
+                        None => format!("data logger's filter: {}", r.analysis.response.describe()),
+                    },
                 ]);
             }
         }

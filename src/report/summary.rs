@@ -47,6 +47,10 @@ struct Reduction<'a> {
     /// The logger's filter the model was seen through: stated, estimated, or
     /// none (issue #18).
     acquisition: &'a crate::peaks::acquisition::ResponseUsed,
+    /// Where an unstated filter was estimated and then dropped as the wall's
+    /// contacts' rounding, why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    acquisition_note: Option<&'a str>,
 }
 
 /// One entry of a test's `"impacts"`: the analysis' impact (time, side entered,
@@ -162,6 +166,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 impacts: impact_docs(&r.impacts),
                 impacts_end: r.impacts.end.as_deref(),
                 acquisition: &r.analysis.response,
+                acquisition_note: r.analysis.acquisition_note.as_deref(),
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }

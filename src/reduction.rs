@@ -6,7 +6,7 @@
 use crate::impacts::{extend_late, extend_late_contacts, impact_table, Geometry, ImpactTable};
 use crate::peaks::late::{contact_peaks, nominal_arc, CONTACT_POST_S};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
-use crate::restitution::{coefficients, uncertainties, Coefficients};
+use crate::restitution::{coefficients, uncertainties, unresolved_reason, Coefficients};
 use crate::wall::{Rocking, Wall};
 
 /// The two channels of one log, in seconds and millimetres, outward positive.
@@ -69,10 +69,21 @@ pub fn physics(rocking: Rocking, wall: &Wall, lever_arm_m: f64) -> Physics {
 
 /// Reduce one log: `log` holds time in s and displacement in mm, outward positive.
 pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOptions) -> Result<Reduced, ReduceError> {
-    let analysis = analyse(&log.time_s, &log.disp_mm, phys, options)?;
+    let mut analysis = analyse(&log.time_s, &log.disp_mm, phys, options)?;
     let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let c = coefficients(&v, e_housner).ok_or(ReduceError::TooFewPeaks { found: v.len() })?;
     let u = analysis.peak_covariance.as_ref().and_then(|cov| uncertainties(&v, cov, e_housner));
+    if let (Some(u), Some(cov)) = (&u, &analysis.peak_covariance) {
+        if let Some(why) = unresolved_reason(u, &v, cov) {
+            analysis.quality = match analysis.quality {
+                Quality::Ok => Quality::Suspect(vec![why]),
+                Quality::Suspect(mut r) => {
+                    r.push(why);
+                    Quality::Suspect(r)
+                }
+            };
+        }
+    }
     Ok(Reduced {
         log,
         analysis,

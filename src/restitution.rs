@@ -96,6 +96,69 @@ impl Coefficients {
     }
 }
 
+/// The largest standard uncertainty a ratio of the tables (r, r⁺, r⁻, r₁, r₁⁺,
+/// r₁⁻, r₂) may have for the test's values to be vouched for: 0.05 (5 pp). A ratio
+/// read to ± 5 pp has a 95 % interval 20 pp wide, wider than the differences the
+/// paper's tables are read for (r⁺ against r⁻, one wall against another: 2–10 pp),
+/// and five times the accuracy the estimator is held to (1 pp). Every ok value of
+/// the shipped campaigns has u ≤ 0.031; a one-sided wall logged at 100 Hz, whose
+/// short inward excursions span a few samples, read r₁ as 0.76 ± 0.64 with status
+/// ok before this limit (docs/accuracy.md).
+pub const RATIO_U_MAX: f64 = 0.05;
+
+/// The ratios whose standard uncertainty exceeds [`RATIO_U_MAX`] (or is not a
+/// number), as (symbol, u), largest u first.
+pub fn unresolved_ratios(u: &Coefficients) -> Vec<(&'static str, f64)> {
+    const SYMBOLS: [&str; 7] = ["r", "r⁺", "r⁻", "r₁", "r₁⁺", "r₁⁻", "r₂"];
+    let a = u.to_array();
+    let mut out: Vec<(&'static str, f64)> = SYMBOLS
+        .iter()
+        .zip(&a[3..])
+        .filter(|(_, u)| u.is_nan() || **u > RATIO_U_MAX)
+        .map(|(s, u)| (*s, *u))
+        .collect();
+    out.sort_by(|x, y| y.1.total_cmp(&x.1));
+    out
+}
+
+/// Why a test's values cannot be vouched for when some ratio exceeds
+/// [`RATIO_U_MAX`]: the ratios and their u, and the first six peaks read to more
+/// than ± 2 [`RATIO_U_MAX`] (relative, from the diagonal of their covariance).
+pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Option<String> {
+    let bad = unresolved_ratios(u);
+    if bad.is_empty() {
+        return None;
+    }
+    let pp = |u: f64| {
+        if u.is_finite() {
+            format!("{:.1} pp", 100.0 * u)
+        } else {
+            "no finite u".into()
+        }
+    };
+    let values: Vec<String> = bad.iter().map(|(s, u)| format!("{s} ± {}", pp(*u))).collect();
+    let peaks: Vec<String> = v
+        .iter()
+        .zip(cov)
+        .enumerate()
+        .take(6)
+        .filter_map(|(k, (v, row))| {
+            let rel = row.get(k).map(|c| c.max(0.0).sqrt() / v.abs())?;
+            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {:.0} %", 100.0 * rel))
+        })
+        .collect();
+    let why = if peaks.is_empty() {
+        String::new()
+    } else {
+        format!(" ({}: the log has too few samples or too much noise around them)", peaks.join(", "))
+    };
+    Some(format!(
+        "the log does not resolve {}: a ratio read to more than ± {:.0} pp cannot be vouched for{why}",
+        values.join(", "),
+        100.0 * RATIO_U_MAX
+    ))
+}
+
 /// Standard uncertainty of every quantity, propagated to first order from the
 /// covariance Σ_v of the first six peaks: u_q² = ∇q Σ_v ∇qᵀ, with ∇q by central
 /// differences (step 10⁻⁶ |v_k|). The peaks of one fit are correlated (they share
@@ -131,6 +194,29 @@ pub fn uncertainties(v: &[f64], cov: &[Vec<f64>], e_h: f64) -> Option<Coefficien
 
 #[cfg(test)]
 mod tests {
+
+    /// The ratios above the limit, largest first; a u that is not a number is
+    /// never read as resolved; e, e⁺, e⁻ are not ratios of the tables' limit.
+    #[test]
+    fn unresolved_ratios_are_named_largest_first() {
+        // e, e⁺, e⁻ at 0.5, the ratios at or below 0.05.
+        let u = Coefficients::from_array([0.5, 0.5, 0.5, 0.01, 0.02, 0.03, 0.04, 0.05, 0.01, 0.01]);
+        assert!(unresolved_ratios(&u).is_empty(), "{:?}", unresolved_ratios(&u));
+        let mut a = u.to_array();
+        (a[4], a[6], a[9]) = (0.06, 0.64, f64::NAN);
+        let names: Vec<&str> = unresolved_ratios(&Coefficients::from_array(a)).iter().map(|x| x.0).collect();
+        assert_eq!(names, ["r₂", "r₁", "r⁺"]);
+        let v = [-500.0, 400.0, -320.0, 260.0, -200.0, 160.0];
+        let cov: Vec<Vec<f64>> = (0..6).map(|k| (0..6).map(|j| if j == k { 1.0 } else { 0.0 }).collect()).collect();
+        assert_eq!(unresolved_reason(&u, &v, &cov), None);
+        let why = unresolved_reason(&Coefficients::from_array(a), &v, &cov).unwrap();
+        assert!(
+            why.starts_with("the log does not resolve r₂ ± no finite u, r₁ ± 64.0 pp, r⁺ ± 6.0 pp"),
+            "{why}"
+        );
+        assert!(!why.contains("peak"), "no peak is read loosely here: {why}");
+    }
+
     use super::*;
 
     /// r₁ = |v_1/v_0| / e_H with independent peaks: u(r₁)/r₁ = √((u0/v0)² + (u1/v1)²).

@@ -22,6 +22,9 @@ pub enum Kind {
     /// No filter stated, and two responses (two filter families, or a filter and
     /// compliant contacts) fit the log with ratios that differ.
     FilterUnknown,
+    /// A ratio of the tables read to more than ± 5 pp
+    /// ([`crate::restitution::RATIO_U_MAX`]).
+    Unresolved,
     /// A reason this module does not know (a new check): shown as the estimator says it.
     Other,
 }
@@ -39,6 +42,7 @@ const PHRASES: &[(&str, Kind)] = &[
     ("the contact model overshoots", Kind::ContactOvershoot),
     ("does not settle where the half-cycle ends", Kind::ZeroReadings),
     ("the logger's filter is not stated and the log cannot tell", Kind::FilterUnknown),
+    ("a ratio read to more than", Kind::Unresolved),
 ];
 
 /// The kind of one reason of the estimator.
@@ -136,6 +140,12 @@ pub fn advice(kind: Kind) -> Advice {
             how_far: "On 200 synthetic tests with compliant contacts and no filter stated, the 6 flagged for this were off by 2.00 pp at the median and 5.75 pp at worst (the worst of the seven values of each test); on 500 idealised tests, the one flagged for this was 0.04 pp off (docs/accuracy.md).",
             rerun: "state the logger's filter in the manifest's [acquisition] (type, order and cut-off from the logger's data sheet; filter = \"none\" if it has none) and re-run reduce.",
         },
+        Kind::Unresolved => Advice {
+            title: "Some ratios are read too loosely to use: their standard uncertainty is above 5 pp.",
+            look: "the velocity panel of the motion plot at the peaks named: how many samples span each, and how large the noise is beside them.",
+            how_far: "As far as their u says, and no closer: on a one-sided engine-made wall logged at 100 Hz, whose inward excursions span a few samples, r₁ read 0.76 ± 0.64 against the engine's 0.68 (docs/accuracy.md).",
+            rerun: "log at a higher rate, so that the half-cycles named span more samples; the ratios the reason does not name are as resolved as their u says.",
+        },
         Kind::Other => Advice {
             title: "The estimator cannot vouch for this test.",
             look: "the motion and ratios plots of the test.",
@@ -172,6 +182,7 @@ mod tests {
                 acquisition::contact_check(acquisition::Generic::Bessel4, 20.0, &[-100.0, 50.0], &[-100.0, 40.0], -1.0),
                 Kind::FilterUnknown,
             ),
+            (unresolved_case(), Kind::Unresolved),
         ];
         for (reason, want) in cases {
             let reason = reason.unwrap_or_else(|| panic!("the {want:?} case does not trip its check"));
@@ -179,6 +190,17 @@ mod tests {
             assert!(!reason.contains("; "), "a reason holds the separator: {reason}");
         }
         assert_eq!(kind("something new"), Kind::Other);
+    }
+
+    /// Six peaks whose peak 1 is read to ± 80 %: r₁ and the ratios through it.
+    fn unresolved_case() -> Option<String> {
+        let v: [f64; 6] = [-500.0, 400.0, -320.0, 260.0, -200.0, 160.0];
+        let mut cov = vec![vec![0.0; 6]; 6];
+        for (k, row) in cov.iter_mut().enumerate() {
+            row[k] = (if k == 1 { 0.8 * v[k] } else { 0.005 * v[k] }).powi(2);
+        }
+        let u = crate::restitution::uncertainties(&v, &cov, 0.97)?;
+        crate::restitution::unresolved_reason(&u, &v, &cov)
     }
 
     #[test]

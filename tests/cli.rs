@@ -935,3 +935,28 @@ fn facade_law_set() {
         assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
     }
 }
+
+/// `rocklab reduce DIR` reads DIR/campaign.toml (what `init` writes) and gives the
+/// same summary as the manifest's path; a folder without one is refused with what
+/// to do, and nothing is written.
+#[test]
+fn a_campaign_folder_stands_for_its_manifest() {
+    let (dir, manifest) = campaign(&[]);
+    let tmp = tempfile::tempdir().unwrap();
+    let (by_dir, by_file) = (
+        reduce(dir.path(), &tmp.path().join("a"), &[]),
+        reduce(&manifest, &tmp.path().join("b"), &[]),
+    );
+    assert_eq!((by_dir.code, by_file.code), (0, 0), "{}", by_dir.stderr);
+    assert_eq!(by_dir.summary["manifest_sha256"], by_file.summary["manifest_sha256"]);
+    assert_eq!(by_dir.summary["tests"][0]["r"], by_file.summary["tests"][0]["r"]);
+    let empty = tempfile::tempdir().unwrap();
+    let none = reduce(empty.path(), &tmp.path().join("c"), &[]);
+    assert_ne!(none.code, 0);
+    assert!(
+        none.stderr.contains("without a campaign.toml") && none.stderr.contains("rocklab init"),
+        "{}",
+        none.stderr
+    );
+    assert!(!tmp.path().join("c").exists());
+}

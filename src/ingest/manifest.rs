@@ -595,21 +595,6 @@ time = { column = "t_ms", unit = "ms" }
     }
 
     #[test]
-    fn a_directory_stands_for_its_campaign_toml() {
-        let dir = tempfile::tempdir().unwrap();
-        let file = dir.path().join("campaign.toml");
-        std::fs::write(&file, BASE).unwrap();
-        let by_dir = Campaign::load(dir.path()).unwrap();
-        let by_file = Campaign::load(&file).unwrap();
-        assert_eq!(by_dir.manifest_path, file);
-        assert_eq!(by_dir.manifest_sha256, by_file.manifest_sha256);
-        assert_eq!(by_dir.tests[0].file, by_file.tests[0].file);
-        std::fs::remove_file(&file).unwrap();
-        let e = Campaign::load(dir.path()).unwrap_err().to_string();
-        assert!(e.contains("without a campaign.toml") && e.contains("rocklab init"), "{e}");
-    }
-
-    #[test]
     fn defaults_merge_with_overrides() {
         let c = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
         assert_eq!(c.tests[0].time.column, "time_s");

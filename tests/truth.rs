@@ -539,7 +539,9 @@ fn mujoco_holdouts_reduced_or_flagged() {
 /// The issue's criterion on both hold-out campaigns: at most one test flagged
 /// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
 /// within 2 u. Fails today on the one-sided campaign (see
-/// `mujoco_holdouts_reduced_or_flagged`).
+/// `mujoco_holdouts_reduced_or_flagged`): r₁ = v₁/v₀ of H1_140_2, H1_150_1
+/// and H1_160_2, where the wall leaves the transverse walls (docs/accuracy.md,
+/// "One-sided: the exit from the inward side, and the restraint's amplitude").
 #[test]
 #[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.24 pp"]
 fn holdouts_meet_the_issue() {

@@ -15,6 +15,16 @@ with a damped compliant contact (a lossy inward restraint). Same engine set-up a
 `--seed` replaces the preset's seed (other beddings, restraints, noise and drift for the
 same wall and tests); a draw whose wall stops rocking before peak 6 is refused.
 
+`--resimulate TEST` runs one test of the campaign in `--out` again from the draws stored
+in its truth.json `sim` block (the preset must be the one that made it) and writes the
+engine's trajectory at every 0.1 ms step to `--trace`, on the log's time axis: time_s,
+x_mm (sensor point, rest subtracted), v_mm_s, theta_rad. It checks that the peaks come
+out as in truth.json. Compare it with the global fit's curve (`ENGINE_CURVE=DIR` in
+`tests/truth.rs`'s `engine_campaigns`, docs/accuracy.md):
+
+    python3 tools/mujoco_campaign.py --preset holdout-one-sided \
+        --out fixtures/campaigns/mujoco-holdout-one-sided --resimulate H1_150_1 --trace /tmp/H1_150_1.txt
+
 Truth: peaks[k] is the extreme of the sensor point's horizontal velocity within
 half-cycle k (between zero crossings k-1 and k of theta), from the engine's state at
 every 0.1 ms step; the table values are computed from those peaks (paper Eqs. 3-6).
@@ -212,6 +222,37 @@ def tables(v, e_h):
                 r2=0.5 * (loc[0] + loc[1]) / e_h)
 
 
+class Replay:
+    """The stored draws of a test's `sim` block, handed out in the order `build` draws them."""
+
+    def __init__(self, sim):
+        self.values = [sim["floor_solref"][0], sim["friction_mu"]]
+        if "obst_K_target_per_s2" in sim:
+            self.values += [sim["obst_K_target_per_s2"], sim["obst_zeta"]]
+
+    def uniform(self, a, b):
+        return self.values.pop(0)
+
+
+def resimulate(p, out, tid, trace):
+    """Run test `tid` of the campaign in `out` again (module docs) and write its trajectory."""
+    truth = json.load(open(os.path.join(out, "truth.json")))
+    test = next(x for x in truth["tests"] if x["id"] == tid)
+    sim = test["sim"]
+    a, _, t_rel, _ = simulate(p, sim["x0_mm_nominal"], Replay(sim))
+    peaks, _ = truth_peaks(a, t_rel, p["rocking"])
+    got = [q["velocity_mm_s"] for q in peaks[:6]]
+    want = [q["velocity_mm_s"] for q in test["peaks"][:6]]
+    if max(abs(g - w) for g, w in zip(got, want)) > 1e-3:
+        raise SystemExit(f"{tid}: peaks {got} differ from truth.json's {want}: another preset or engine?")
+    shift = t_rel - sim["t_release_s"]
+    with open(trace, "w") as f:
+        f.write("time_s x_mm v_mm_s theta_rad\n")
+        for row in a:
+            f.write(f"{row[0] - shift:.6f} {1000.0 * (row[1] - a[-1, 1]):.5f} {1000.0 * row[2]:.4f} {row[3]:.8f}\n")
+    print(f"{tid}: peaks as in truth.json; {len(a)} steps written to {trace}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--preset", required=True, choices=sorted(PRESETS))
@@ -219,8 +260,14 @@ def main():
     ap.add_argument("--seed", type=int, default=None,
                     help="seed of the random draws (default: the preset's); another seed draws "
                          "other beddings, restraints, noise and drift for the same wall and tests")
+    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
+    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
     args = ap.parse_args()
     p = PRESETS[args.preset]
+    if args.resimulate:
+        if not args.trace:
+            raise SystemExit("--resimulate needs --trace FILE")
+        return resimulate(p, args.out, args.resimulate, args.trace)
     seed = p["seed"] if args.seed is None else args.seed
     rng = np.random.default_rng(seed)
     how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")

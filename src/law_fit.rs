@@ -121,6 +121,8 @@ pub struct LawFit {
 /// Why no law could be fitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LawFitError {
+    #[error("no test is in the means (each is suspect, excluded or not reduced): the law is fitted to the tests the campaign vouches for")]
+    NoTests,
     #[error("no test has per-impact uncertainties (the default estimator gives them)")]
     NoUncertainties,
     #[error("side {side}: {n} impacts with uncertainties; the law needs at least 4 (two parameters and two degrees of freedom)")]
@@ -291,6 +293,9 @@ fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Resu
 /// The campaign's law from its tests' impacts (module docs). The caller passes only
 /// the tests the campaign vouches for (status ok, not excluded from the means).
 pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFitError> {
+    if tests.is_empty() {
+        return Err(LawFitError::NoTests);
+    }
     if tests.iter().all(|t| t.table.r_cov.is_none()) {
         return Err(LawFitError::NoUncertainties);
     }
@@ -512,6 +517,16 @@ mod tests {
             raw: Vec::new(),
             end: None,
         }
+    }
+
+    /// No test vouched for is said as such, not as missing uncertainties.
+    #[test]
+    fn no_test_is_not_a_missing_uncertainty() {
+        assert_eq!(fit_law(Rocking::OneSided, &[]).unwrap_err(), LawFitError::NoTests);
+        let mut t = table(&[(0.3, 0.9, Side::Inward)], 0.01);
+        t.r_cov = None;
+        let e = fit_law(Rocking::OneSided, &[TestImpacts { id: "a", table: &t }]).unwrap_err();
+        assert_eq!(e, LawFitError::NoUncertainties);
     }
 
     /// Exact data on the form are recovered exactly, and the constant is rejected;

@@ -192,7 +192,14 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
 /// stops at the first impact with no such pair, with e > 1 or with u(r) above
 /// [`MAX_LATE_R_U`]. `late[0]` must be the table's last peak read again; the
 /// contact readings are taken where the late readings reach (their 20 σ stop).
-pub fn extend_late_two_sided(table: &mut ImpactTable, late: &[LatePeak], contacts: &[ContactPeak], e_h: f64, geo: &Geometry) {
+pub fn extend_late_two_sided(
+    table: &mut ImpactTable,
+    late: &[LatePeak],
+    contacts: &[ContactPeak],
+    e_h: f64,
+    geo: &Geometry,
+    arc: Option<(f64, f64)>,
+) {
     if late.first().map(|p| p.k) != Some(table.impacts.len()) {
         return;
     }
@@ -208,6 +215,10 @@ pub fn extend_late_two_sided(table: &mut ImpactTable, late: &[LatePeak], contact
     let mut crossings: Vec<f64> = Vec::new();
     for w in late.windows(2) {
         let (k0, k1) = (w[0].k, w[1].k);
+        if let Some(why) = arc.and_then(|arc| not_rocking(k0, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
+            table.end = Some(why);
+            break;
+        }
         let pair = [contact(k0).zip(contact(k1)), w[0].smooth.zip(w[1].smooth), w[0].kink.zip(w[1].kink)]
             .into_iter()
             .flatten()
@@ -246,13 +257,20 @@ pub fn extend_late_two_sided(table: &mut ImpactTable, late: &[LatePeak], contact
 /// the noise; the list stops at the first impact without, with e > 1, or with
 /// u(r) above [`MAX_CONTACT_R_U`]. Uncertainties and correlations as
 /// [`extend_late`]'s.
-pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry) {
+pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry, arc: Option<(f64, f64)>) {
     let Some(i0) = peaks.iter().position(|p| p.k == table.impacts.len()) else {
         return;
     };
     let peaks = &peaks[i0..];
     let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
     for w in peaks.windows(2) {
+        // The free arcs are the outward half-cycles (k even); the inward ones push
+        // into the transverse walls.
+        let free_arc = arc.filter(|_| w[1].k.is_multiple_of(2));
+        if let Some(why) = free_arc.and_then(|arc| not_rocking(w[0].k, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
+            table.end = Some(why);
+            break;
+        }
         let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
         let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else {
             let unread = if read(&w[0]).is_none() { w[0].k } else { w[1].k };
@@ -339,6 +357,43 @@ pub fn reread_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], n_table: 
             cov[k + 1][k] = x;
         }
     }
+}
+
+/// How much longer than the free rocking arc of its apex a half-cycle may last
+/// and still be free rocking ([`not_rocking`]).
+pub const MAX_ARC_RATIO: f64 = 1.1;
+
+/// Why impact k is not a rocking impact, if it is not: the half-cycle after it
+/// (apex `apex_mm`, lasting `duration_s`) is no free rocking arc. The rigid
+/// block's free arc of amplitude a = θ_apex/α (paper Eq. 1 linearised near
+/// θ = 0, θ'' = q² (θ ∓ α)) goes from the rest line to its apex and back in
+///
+///   T(a) = (2/q) arcosh(1/(1 − a)),
+///
+/// which falls to 0 with a; a wall that no longer lifts off vibrates on its
+/// bedding at the bedding's own period, whatever its amplitude. `arc` = (q in
+/// s⁻¹, L tan α in mm) as the log's own fit found them
+/// ([`crate::peaks::Analysis::small_arc`]). Measured on the MuJoCo campaigns
+/// (docs/restitution-law.md): T/T(a) = 1.00–1.01 while an edge lifts off for
+/// ≥ 80 % of the half-cycle, 1.03–1.13 as the lift-off fades (0.3–0.7 of
+/// it), 1.11–2.31 once it stops; above [`MAX_ARC_RATIO`] the wall is taken as
+/// no longer rocking and its velocity ratios, which then follow the bedding's
+/// damping, are not reported as coefficients of restitution.
+pub fn not_rocking(k: usize, apex_mm: f64, duration_s: f64, arc: (f64, f64), geo: &Geometry) -> Option<String> {
+    let alpha = (arc.1 / geo.lever_arm_mm).atan();
+    let a = (apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / alpha;
+    if !(a > 0.0 && a < 1.0 && arc.0 > 0.0 && duration_s > 0.0) {
+        return None;
+    }
+    let rigid = 2.0 / arc.0 * (1.0 / (1.0 - a)).acosh();
+    let ratio = duration_s / rigid;
+    (ratio > MAX_ARC_RATIO).then(|| {
+        format!(
+            "impact {k}: the half-cycle after it lasts {:.0} ms, {ratio:.2} × the free rocking arc of its amplitude a = {a:.4} ({:.0} ms): the wall no longer rocks (it vibrates on its bedding), and its velocity ratios are no coefficients of restitution",
+            duration_s * 1e3,
+            rigid * 1e3
+        )
+    })
 }
 
 /// The end of a list that ran out of read peaks: impact k is the first without.
@@ -601,7 +656,7 @@ mod tests {
         };
         table.impacts.push(impact_stub(1));
         table.r_cov = Some(vec![vec![1e-4, 0.0], vec![0.0, 1e-4]]);
-        extend_late_contacts(&mut table, &peaks, 1.0, &geo);
+        extend_late_contacts(&mut table, &peaks, 1.0, &geo, None);
         let ks: Vec<usize> = table.impacts.iter().map(|i| i.k).collect();
         assert_eq!(ks, [0, 1, 2], "impact 2 from peaks 2 and 3; peak 4 does not fit");
         assert!((table.impacts[2].r - 70.0 / 80.0).abs() < 1e-12);
@@ -612,7 +667,7 @@ mod tests {
         );
         // Starting past the table: nothing added.
         let mut short = ImpactTable::default();
-        extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo);
+        extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo, None);
         assert!(short.impacts.is_empty());
     }
 
@@ -646,7 +701,7 @@ mod tests {
             r_cov: Some(vec![vec![0.0; 5]; 5]),
             ..ImpactTable::default()
         };
-        extend_late_two_sided(&mut table, &late_peaks, &contacts, 1.0, &geo);
+        extend_late_two_sided(&mut table, &late_peaks, &contacts, 1.0, &geo, None);
         let ks: Vec<usize> = table.impacts.iter().map(|i| i.k).collect();
         // 5, 6: contact pairs; 7: contact 8 is not at the noise and peak 8 has
         // neither a resolved extreme nor a kink: the list ends.
@@ -667,7 +722,7 @@ mod tests {
             impacts: (0..5).map(impact_stub).collect(),
             ..ImpactTable::default()
         };
-        extend_late_two_sided(&mut plain, &late_peaks, &[], 1.0, &geo);
+        extend_late_two_sided(&mut plain, &late_peaks, &[], 1.0, &geo, None);
         assert_eq!(plain.impacts.len(), 7);
         assert!((plain.impacts[6].r - 80.0 / 90.0).abs() < 1e-12, "the kinks' ratio (both 1.01 × v)");
     }

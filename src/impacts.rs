@@ -179,7 +179,7 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
     if table.end.is_none() {
         table.end = Some(no_later_peak(table.impacts.len() + added.len()));
     }
-    let crossings: Vec<f64> = late.iter().map(|p| p.crossing_s).collect();
+    let crossings: Vec<(usize, f64)> = late.iter().map(|p| (p.k, p.crossing_s)).collect();
     append_late(table, &added, &crossings);
 }
 
@@ -212,7 +212,6 @@ pub fn extend_late_two_sided(
             .map(|r| r.reading)
     };
     let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
-    let mut crossings: Vec<f64> = Vec::new();
     for w in late.windows(2) {
         let (k0, k1) = (w[0].k, w[1].k);
         if let Some(why) = arc.and_then(|arc| not_rocking(k0, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
@@ -230,22 +229,17 @@ pub fn extend_late_two_sided(
             break;
         };
         match late_coefficient(k0, w[0].apex_mm, a, b, e_h, geo, MAX_LATE_R_U) {
-            Ok(coefficient) => {
-                added.push((coefficient, a, b));
-                crossings.push(w[0].crossing_s);
-            }
+            Ok(coefficient) => added.push((coefficient, a, b)),
             Err(why) => {
                 table.end = Some(why);
                 break;
             }
         }
     }
-    if let Some(p) = late.get(added.len()) {
-        crossings.push(p.crossing_s);
-    }
     if table.end.is_none() {
         table.end = Some(no_later_peak(table.impacts.len() + added.len()));
     }
+    let crossings: Vec<(usize, f64)> = late.iter().map(|p| (p.k, p.crossing_s)).collect();
     append_late(table, &added, &crossings);
 }
 
@@ -258,41 +252,77 @@ pub fn extend_late_two_sided(
 /// u(r) above [`MAX_CONTACT_R_U`]. Uncertainties and correlations as
 /// [`extend_late`]'s.
 pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry, arc: Option<(f64, f64)>) {
-    let Some(i0) = peaks.iter().position(|p| p.k == table.impacts.len()) else {
+    let from = table.impacts.len();
+    extend_contacts_from(table, peaks, from, e_h, geo, arc, false, false);
+}
+
+/// The impacts from impact `from` on from contact readings (see
+/// [`extend_late_contacts`]); two-sided walls (`two_sided`): every half-cycle
+/// is a free arc, and the cap of u(r) is [`MAX_LATE_R_U`].
+#[allow(clippy::too_many_arguments)]
+fn extend_contacts_from(
+    table: &mut ImpactTable,
+    peaks: &[ContactPeak],
+    from: usize,
+    e_h: f64,
+    geo: &Geometry,
+    arc: Option<(f64, f64)>,
+    two_sided: bool,
+    skip: bool,
+) {
+    let Some(i0) = peaks.iter().position(|p| p.k == from) else {
         return;
     };
     let peaks = &peaks[i0..];
+    let cap = if two_sided { MAX_LATE_R_U } else { MAX_CONTACT_R_U };
     let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
     for w in peaks.windows(2) {
-        // The free arcs are the outward half-cycles (k even); the inward ones push
-        // into the transverse walls.
-        let free_arc = arc.filter(|_| w[1].k.is_multiple_of(2));
+        // One-sided, the free arcs are the outward half-cycles (k even); the
+        // inward ones push into the transverse walls.
+        let free_arc = arc.filter(|_| two_sided || w[1].k.is_multiple_of(2));
         if let Some(why) = free_arc.and_then(|arc| not_rocking(w[0].k, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
-            table.end = Some(why);
+            table.end.get_or_insert(why);
             break;
         }
         let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
-        let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else {
-            let unread = if read(&w[0]).is_none() { w[0].k } else { w[1].k };
-            table.end = Some(format!(
-                "impact {}: peak {unread} has no reading of the contact model that fits the samples to the noise",
-                w[0].k
-            ));
-            break;
+        let pair = match (read(&w[0]), read(&w[1])) {
+            (Some(a), Some(b)) => late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, cap).map(|c| (c, a, b)),
+            (a, _) => Err(format!(
+                "impact {}: peak {} has no reading of the contact model that fits the samples to the noise",
+                w[0].k,
+                if a.is_none() { w[0].k } else { w[1].k }
+            )),
         };
-        match late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_CONTACT_R_U) {
-            Ok(c) => added.push((c, a, b)),
+        match pair {
+            Ok(p) => added.push(p),
             Err(why) => {
-                table.end = Some(why);
-                break;
+                table.end.get_or_insert(why);
+                if !skip {
+                    break;
+                }
             }
         }
     }
     if table.end.is_none() {
-        table.end = Some(no_later_peak(table.impacts.len() + added.len()));
+        table.end = Some(no_later_peak(from + added.len()));
     }
-    let crossings: Vec<f64> = peaks.iter().map(|p| p.crossing_s).collect();
+    let crossings: Vec<(usize, f64)> = peaks.iter().map(|p| (p.k, p.crossing_s)).collect();
     append_late(table, &added, &crossings);
+}
+
+/// A flagged test's impacts read by the contact model alone, from impact 1 on
+/// (a test the table's global fit cannot vouch for: its impacts are not read
+/// from that fit, and impact 0, the release arc's end, is not read by the
+/// contact model): the readings of [`extend_late_contacts`] (one-sided) or
+/// the contact pairs of [`extend_late_two_sided`] (two-sided), with their
+/// stops. docs/restitution-law.md says what they are worth.
+pub fn local_impacts(peaks: &[ContactPeak], e_h: f64, geo: &Geometry, arc: (f64, f64), two_sided: bool) -> ImpactTable {
+    let mut table = ImpactTable {
+        r_cov: Some(Vec::new()),
+        ..ImpactTable::default()
+    };
+    extend_contacts_from(&mut table, peaks, 1, e_h, geo, Some(arc), two_sided, true);
+    table
 }
 
 /// One-sided walls: the table's impacts 1 … n − 2 read again by the contact
@@ -429,9 +459,10 @@ fn late_coefficient(k: usize, apex_mm: f64, a: Reading, b: Reading, e_h: f64, ge
 }
 
 /// Appends the late impacts, their covariance block and their raw impacts;
-/// `crossings[i]` ends the half-cycle of the i-th added impact (one more for
-/// the last one's next peak).
-fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], crossings: &[f64]) {
+/// `crossings` gives the crossing that ends half-cycle k, (k, time), for every
+/// added impact's k and the last one's k + 1.
+fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], crossings: &[(usize, f64)]) {
+    let crossing = |k: usize| crossings.iter().find(|c| c.0 == k).map_or(f64::NAN, |c| c.1);
     if added.is_empty() {
         return;
     }
@@ -456,10 +487,10 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
         }
     }
     table.raw.truncate(n0);
-    for (i, (c, a, b)) in added.iter().enumerate() {
+    for (c, a, b) in added {
         table.raw.push(Impact {
             k: c.k,
-            time_s: crossings[i],
+            time_s: crossing(c.k),
             entering: c.side,
             v_before_mm_s: a.velocity_mm_s,
             v_after_mm_s: Some(b.velocity_mm_s),
@@ -469,7 +500,7 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
         let next = c.k + 1;
         table.raw.push(Impact {
             k: next,
-            time_s: crossings[added.len()],
+            time_s: crossing(next),
             entering: if next % 2 == 0 { Side::Inward } else { Side::Outward },
             v_before_mm_s: b.velocity_mm_s,
             v_after_mm_s: None,

@@ -140,6 +140,10 @@ struct EveryImpact {
     /// value of the ok tests.
     flagged: usize,
     worst_ok_pp: f64,
+    /// The flagged tests' impacts read by the contact model alone
+    /// ([`rocklab::impacts::local_impacts`]): listed, and (test, k, error, u).
+    flagged_listed: usize,
+    flagged_local: Vec<(String, usize, f64, f64)>,
 }
 
 impl EveryImpact {
@@ -164,6 +168,20 @@ impl EveryImpact {
         );
         for x in &self.reported {
             println!("  {} k{} {:+.4} (u {:.4})", x.0, x.1, x.2, x.3);
+        }
+        if self.flagged > 0 {
+            let rms = (self.flagged_local.iter().map(|e| e.2 * e.2).sum::<f64>() / self.flagged_local.len().max(1) as f64).sqrt();
+            let mut z: Vec<f64> = self.flagged_local.iter().map(|x| x.2.abs() / x.3).collect();
+            z.sort_by(f64::total_cmp);
+            println!(
+                "  flagged tests, the contact model alone: {} of their {} listed impacts, RMS {rms:.4}, median |err|/u {:.2}",
+                self.flagged_local.len(),
+                self.flagged_listed,
+                z.get(z.len() / 2).copied().unwrap_or(f64::NAN)
+            );
+            for x in &self.flagged_local {
+                println!("    {} k{} {:+.4} (u {:.4})", x.0, x.1, x.2, x.3);
+            }
         }
     }
 }
@@ -211,6 +229,26 @@ fn truth_impacts(tt: &serde_json::Value, e_h: f64) -> Vec<(usize, f64, bool)> {
         .collect()
 }
 
+/// A flagged test's impacts read by the contact model alone
+/// ([`rocklab::impacts::local_impacts`]).
+fn flagged_local(r: &rocklab::reduction::Reduced, c: &rocklab::ingest::Campaign, lever_mm: f64, e_h: f64) -> rocklab::impacts::ImpactTable {
+    use rocklab::peaks::late::{arc_contact_peaks, contact_peaks, nominal_arc, CONTACT_POST_S};
+    let p = c.wall().rocking_part().p_squared().sqrt();
+    let arc = r.analysis.small_arc.unwrap_or_else(|| nominal_arc(p, c.alpha_rad, lever_mm));
+    let two = c.rocking == rocklab::wall::Rocking::TwoSided;
+    let peaks = if two {
+        arc_contact_peaks(&r.analysis, &r.log.time_s, lever_mm, arc, 12, CONTACT_POST_S)
+    } else {
+        contact_peaks(&r.analysis, &r.log.time_s, lever_mm, arc, 12, CONTACT_POST_S)
+    };
+    let geo = rocklab::impacts::Geometry {
+        time_s: &r.log.time_s,
+        lever_arm_mm: lever_mm,
+        alpha_rad: c.alpha_rad,
+    };
+    rocklab::impacts::local_impacts(&peaks, e_h, &geo, arc, two)
+}
+
 /// [`every_impact`] of the campaign in `dir`.
 fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
     use rocklab::ingest::Campaign;
@@ -224,6 +262,8 @@ fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
         reported: Vec::new(),
         flagged: 0,
         worst_ok_pp: 0.0,
+        flagged_listed: 0,
+        flagged_local: Vec::new(),
     };
     let (mut rocking, mut all) = (empty(), empty());
     for t in &res.tests {
@@ -234,6 +274,19 @@ fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
         let Some(r) = t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok()) else {
             rocking.flagged += 1;
             all.flagged += 1;
+            rocking.flagged_listed += listed.iter().filter(|l| l.2).count();
+            all.flagged_listed += listed.len();
+            let Ok(r) = t.result.as_ref() else { continue };
+            let local = flagged_local(r, &res.campaign, t.spec.lever_arm_m * 1e3, e_h);
+            for (k, r_true, rocks) in listed {
+                if let Some(i) = local.impacts.iter().find(|i| i.k == k) {
+                    let entry = (t.spec.id.clone(), k, i.r - r_true, i.r_u.unwrap_or(f64::NAN));
+                    if rocks {
+                        rocking.flagged_local.push(entry.clone());
+                    }
+                    all.flagged_local.push(entry);
+                }
+            }
             continue;
         };
         let c = serde_json::to_value(r.coefficients).unwrap();

@@ -799,6 +799,26 @@ mod tests {
         assert_eq!(cov[0][1], 5e-5, "the table's own covariance elsewhere");
     }
 
+    /// [`not_rocking`]: a half-cycle as long as the free rocking arc of its
+    /// amplitude, T(a) = (2/q) arcosh(1/(1 − a)), is rocking; one 1.2 × as long
+    /// is not, and says so.
+    #[test]
+    fn a_half_cycle_longer_than_the_free_arc_is_not_rocking() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 2000.0,
+            alpha_rad: 0.2,
+        };
+        let (q, centre) = (2.5, 2000.0 * 0.2f64.tan());
+        let apex = 2000.0 * (0.05f64 * 0.2).sin();
+        let t = 2.0 / q * (1.0f64 / 0.95).acosh();
+        assert!(not_rocking(3, apex, t, (q, centre), &geo).is_none());
+        assert!(not_rocking(3, apex, 1.05 * t, (q, centre), &geo).is_none());
+        let why = not_rocking(3, apex, 1.2 * t, (q, centre), &geo).expect("not rocking");
+        assert!(why.starts_with("impact 3: the half-cycle after it lasts"), "{why}");
+        assert!(why.contains("1.20 ×") && why.contains("a = 0.0500"), "{why}");
+    }
+
     fn impact_stub(k: usize) -> ImpactCoefficient {
         ImpactCoefficient {
             k,

@@ -170,6 +170,37 @@ fn impacts_in_spec_shape_become_rows() {
     assert_eq!(strs(&df, "test"), ["T0", "T1", "T2"]);
 }
 
+/// Each impact carries its test's status (a suspect test's impacts are printed,
+/// not vouched for), and an archive written before that column gets it from its
+/// `tests` table when read, queried or added to.
+#[test]
+fn impacts_carry_their_tests_status_also_in_older_archives() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut doc = spec_summary("aa", 3, 4);
+    doc["tests"][1]["status"] = json!("suspect: the fit misses the log");
+    let arc = tmp.path().join("arc");
+    archive::add(&arc, &[write_summary(&tmp.path().join("r"), &doc)]).unwrap();
+    let (_, impacts) = archive::load(&arc).unwrap();
+    let expected: Vec<String> = (0..3)
+        .flat_map(|t| vec![if t == 1 { "suspect: the fit misses the log" } else { "ok" }.to_string(); 4])
+        .collect();
+    assert_eq!(strs(&impacts, "status"), expected);
+    // The same archive as an older rocklab wrote it: impacts without the column.
+    let file = archive::open(&arc).unwrap()[1].clone();
+    let mut old = impacts.drop("status").unwrap();
+    ParquetWriter::new(std::fs::File::create(&file).unwrap()).finish(&mut old).unwrap();
+    let (_, read) = archive::load(&arc).unwrap();
+    assert_eq!(read.get_column_names(), impacts.get_column_names());
+    assert_eq!(strs(&read, "status"), expected);
+    let n = archive::query(&arc, "SELECT count(*) AS n FROM impacts WHERE status = 'ok'").unwrap();
+    assert_eq!(n.column("n").unwrap().get(0).unwrap().extract::<u32>(), Some(8));
+    // Adding to it writes one schema; the old rows keep the status they were given.
+    archive::add(&arc, &[write_summary(&tmp.path().join("s"), &spec_summary("bb", 1, 2))]).unwrap();
+    let (_, after) = archive::load(&arc).unwrap();
+    assert_eq!(after.height(), 14);
+    assert_eq!(strs(&after, "status").iter().filter(|s| s.starts_with("suspect")).count(), 4);
+}
+
 /// (tests rows, impacts rows, the shas in each) of an archive as a reader finds it.
 fn state(arc: &Path) -> (usize, usize, BTreeSet<String>, BTreeSet<String>) {
     let (t, i) = archive::load(arc).unwrap();

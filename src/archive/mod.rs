@@ -95,6 +95,26 @@ fn scan(archive: &Path, name: &str, empty: &DataFrame) -> Result<LazyFrame, Arch
     LazyFrame::scan_parquet(p, ScanArgsParquet::default()).map_err(table_err(&path))
 }
 
+/// The impacts table. An archive written before each impact carried its test's
+/// status (`tests.status`) gets it from `tests`, by manifest and test, so that
+/// queries and the next add see one schema.
+fn scan_impacts(archive: &Path, empty: &rows::Reduction) -> Result<LazyFrame, ArchiveError> {
+    let path = table_path(archive, "impacts");
+    let lf = scan(archive, "impacts", &empty.impacts)?;
+    if lf.clone().collect_schema().map_err(table_err(&path))?.contains("status") {
+        return Ok(lf);
+    }
+    let keys = [col("manifest_sha256"), col("test")];
+    let status = scan(archive, "tests", &empty.tests)?.select([col("manifest_sha256"), col("test"), col("status")]);
+    let order: Vec<Expr> = empty.impacts.get_column_names().iter().map(|c| col(c.as_str())).collect();
+    // The rows keep their order (a left join need not, unless asked).
+    let args = JoinArgs {
+        maintain_order: MaintainOrderJoin::Left,
+        ..JoinArgs::new(JoinType::Left)
+    };
+    Ok(lf.join(status, keys.clone(), keys, args).select(order))
+}
+
 /// What an add did.
 #[derive(Debug)]
 pub struct Added {
@@ -161,8 +181,13 @@ pub fn add_with_hook(archive: &Path, report_dirs: &[PathBuf], hook: &mut dyn FnM
         reductions.push((r.campaign.clone(), r.sha256.clone(), r.tests.height(), r.impacts.height(), replaced));
     }
     let mut tables = Vec::new();
-    for (name, empty) in [("tests", &empty_tests.tests), ("impacts", &empty_tests.impacts)] {
-        let mut parts = vec![keep(scan(archive, name, empty)?)];
+    for name in TABLES {
+        let old = if name == "tests" {
+            scan(archive, name, &empty_tests.tests)?
+        } else {
+            scan_impacts(archive, &empty_tests)?
+        };
+        let mut parts = vec![keep(old)];
         parts.extend(
             new.iter()
                 .map(|r| if name == "tests" { r.tests.clone() } else { r.impacts.clone() }.lazy()),
@@ -223,7 +248,7 @@ pub fn load(archive: &Path) -> Result<(DataFrame, DataFrame), ArchiveError> {
     recover(archive)?;
     let empty = rows::reduction(&empty_summary(), "")?;
     let tests = scan(archive, "tests", &empty.tests)?.collect().map_err(table_err(archive))?;
-    let impacts = scan(archive, "impacts", &empty.impacts)?.collect().map_err(table_err(archive))?;
+    let impacts = scan_impacts(archive, &empty)?.collect().map_err(table_err(archive))?;
     Ok((tests, impacts))
 }
 
@@ -255,7 +280,7 @@ pub fn query(archive: &Path, sql: &str) -> Result<DataFrame, ArchiveError> {
     let empty = rows::reduction(&empty_summary(), "")?;
     let mut ctx = polars::sql::SQLContext::new();
     ctx.register("tests", scan(archive, "tests", &empty.tests)?);
-    ctx.register("impacts", scan(archive, "impacts", &empty.impacts)?);
+    ctx.register("impacts", scan_impacts(archive, &empty)?);
     ctx.execute(sql).and_then(|lf| lf.collect()).map_err(|e| ArchiveError::Sql(e.to_string()))
 }
 

@@ -16,7 +16,8 @@ const WALL: [&str; 5] = ["height_m", "thickness_m", "width_m", "weight_kN", "hin
 /// Text columns of `tests`, then its numbers (see [`test_columns`]).
 const TEST_TEXT: [&str; 7] = ["campaign", "test", "rocking", "status", "method", "manifest_sha256", "rocklab_version"];
 
-/// Columns of `impacts` (SPEC "Per-impact coefficients"), after campaign, test and sha.
+/// Columns of `impacts` (SPEC "Per-impact coefficients"), after campaign, test, the
+/// test's status, sha, k and side.
 const IMPACT_NUMBERS: [&str; 7] = ["amplitude_over_alpha", "speed_before_mm_s", "speed_after_mm_s", "e", "e_u", "r", "r_u"];
 
 /// Every column of `tests`, in order.
@@ -97,6 +98,7 @@ pub fn reduction(doc: &Value, origin: &str) -> Result<Reduction, ArchiveError> {
 /// One row per impact in SPEC's shape (with its side, e and r) of every test.
 fn impact_rows(tests: &[Value], campaign: &str, sha: &str) -> PolarsResult<(DataFrame, Vec<String>)> {
     let (mut test, mut k, mut side) = (Vec::<String>::new(), Vec::<Option<i64>>::new(), Vec::<Option<String>>::new());
+    let mut status = Vec::<Option<String>>::new();
     let mut numbers: Vec<Vec<Option<f64>>> = vec![Vec::new(); IMPACT_NUMBERS.len()];
     let mut skipped = Vec::new();
     for t in tests {
@@ -112,8 +114,10 @@ fn impact_rows(tests: &[Value], campaign: &str, sha: &str) -> PolarsResult<(Data
             skipped.push(id.to_string());
             continue;
         }
+        let test_status = t.get("status").and_then(Value::as_str).map(str::to_string);
         for i in coefficients {
             test.push(id.to_string());
+            status.push(test_status.clone());
             k.push(i.get("k").and_then(Value::as_i64));
             side.push(i.get("side").and_then(Value::as_str).map(str::to_string));
             for (col, name) in numbers.iter_mut().zip(IMPACT_NUMBERS) {
@@ -125,6 +129,8 @@ fn impact_rows(tests: &[Value], campaign: &str, sha: &str) -> PolarsResult<(Data
     let mut cols = vec![
         Column::new("campaign".into(), vec![campaign.to_string(); n]),
         Column::new("test".into(), test),
+        // The test's status: a suspect test's impacts are printed, not vouched for.
+        Column::new("status".into(), status),
         Column::new("manifest_sha256".into(), vec![sha.to_string(); n]),
         Column::new("k".into(), k),
         Column::new("side".into(), side),

@@ -22,7 +22,7 @@ use rocklab::report::{table::to_markdown, write_files};
     after_help = "Example:\n  rocklab calibrate fixtures/campaigns/one-sided-demo/campaign.toml --out out/cal\n  # writes out/cal/calibration.toml, for `simulate --calibration` and a façade study"
 )]
 pub struct CalibrateArgs {
-    /// Campaign manifest.
+    /// Campaign manifest, or the directory that holds it as `campaign.toml`.
     pub manifest: PathBuf,
     #[arg(long)]
     pub out: PathBuf,

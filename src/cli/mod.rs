@@ -74,7 +74,8 @@ pub struct EstimatorArgs {
     after_help = "Example:\n  rocklab reduce fixtures/campaigns/one-sided-demo/campaign.toml --out out/one-sided\n  # Tables 1–3, plots, summary.json and report.html in out/one-sided"
 )]
 pub struct ReduceArgs {
-    /// Campaign manifest (TOML; docs/reduce.md; `rocklab init` drafts one).
+    /// Campaign manifest (TOML; docs/reduce.md; `rocklab init` drafts one), or the
+    /// directory that holds it as `campaign.toml`.
     pub manifest: PathBuf,
     /// Output folder (created; files in it are replaced atomically).
     #[arg(long)]

@@ -211,9 +211,12 @@ impl Campaign {
         self.wall().rocking_part().p_squared()
     }
 
-    /// Read and validate a manifest file.
+    /// Read and validate a manifest file. A directory stands for the
+    /// `campaign.toml` in it (what `rocklab init DIR` writes); a directory
+    /// without one is refused with what to do.
     pub fn load(path: &Path) -> Result<Campaign> {
-        Self::parse(&read_text(path, FileKind::Manifest)?, path)
+        let file = manifest_in(path)?;
+        Self::parse(&read_text(&file, FileKind::Manifest)?, &file)
     }
 
     /// Parse and validate manifest text; `path` names it in errors and resolves the
@@ -231,6 +234,25 @@ impl Campaign {
 }
 
 type Result<T> = std::result::Result<T, FileError>;
+
+/// The manifest a path names: the path itself, or `DIR/campaign.toml` for a
+/// directory.
+fn manifest_in(path: &Path) -> Result<std::path::PathBuf> {
+    if !path.is_dir() {
+        return Ok(path.to_path_buf());
+    }
+    let file = path.join("campaign.toml");
+    if file.is_file() {
+        return Ok(file);
+    }
+    Err(bad(
+        path,
+        format!(
+            "a directory without a campaign.toml: pass the campaign's manifest, or draft one with `rocklab init {}`",
+            path.display()
+        ),
+    ))
+}
 
 fn bad(path: &Path, msg: impl std::fmt::Display) -> FileError {
     FileError::invalid(path, msg)
@@ -570,6 +592,21 @@ time = { column = "t_ms", unit = "ms" }
         assert_eq!(c.manifest_sha256.len(), 64);
         let other = Campaign::parse(BASE, Path::new("/x/campaign.toml")).unwrap();
         assert_ne!(c.manifest_sha256, other.manifest_sha256);
+    }
+
+    #[test]
+    fn a_directory_stands_for_its_campaign_toml() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("campaign.toml");
+        std::fs::write(&file, BASE).unwrap();
+        let by_dir = Campaign::load(dir.path()).unwrap();
+        let by_file = Campaign::load(&file).unwrap();
+        assert_eq!(by_dir.manifest_path, file);
+        assert_eq!(by_dir.manifest_sha256, by_file.manifest_sha256);
+        assert_eq!(by_dir.tests[0].file, by_file.tests[0].file);
+        std::fs::remove_file(&file).unwrap();
+        let e = Campaign::load(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("without a campaign.toml") && e.contains("rocklab init"), "{e}");
     }
 
     #[test]

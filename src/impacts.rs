@@ -179,7 +179,67 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
     if table.end.is_none() {
         table.end = Some(no_later_peak(table.impacts.len() + added.len()));
     }
-    let crossings: Vec<f64> = late.iter().map(|p| p.crossing_s).collect();
+    let crossings: Vec<(usize, f64)> = late.iter().map(|p| (p.k, p.crossing_s)).collect();
+    append_late(table, &added, &crossings);
+}
+
+/// Two-sided walls: the impacts after the table's from three readings of each
+/// late peak, paired by kind (a ratio of two readings of one kind cancels the
+/// bias they share): first the contact model's ([`crate::peaks::late::arc_contact_peaks`]:
+/// the free arc about the toe of the half-cycle's side plus the contact's
+/// force from its onset), where both peaks' fits are at the noise; else two
+/// resolved extremes; else two kinks ([`extend_late`]'s pairing). The list
+/// stops at the first impact with no such pair, with e > 1 or with u(r) above
+/// [`MAX_LATE_R_U`]. `late[0]` must be the table's last peak read again; the
+/// contact readings are taken where the late readings reach (their 20 σ stop).
+pub fn extend_late_two_sided(
+    table: &mut ImpactTable,
+    late: &[LatePeak],
+    contacts: &[ContactPeak],
+    e_h: f64,
+    geo: &Geometry,
+    arc: Option<(f64, f64)>,
+) {
+    if late.first().map(|p| p.k) != Some(table.impacts.len()) {
+        return;
+    }
+    let contact = |k: usize| {
+        contacts
+            .iter()
+            .find(|c| c.k == k)
+            .and_then(|c| c.reading)
+            .filter(|r| r.fits_noise())
+            .map(|r| r.reading)
+    };
+    let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
+    for w in late.windows(2) {
+        let (k0, k1) = (w[0].k, w[1].k);
+        if let Some(why) = arc.and_then(|arc| not_rocking(k0, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
+            table.end = Some(why);
+            break;
+        }
+        let pair = [contact(k0).zip(contact(k1)), w[0].smooth.zip(w[1].smooth), w[0].kink.zip(w[1].kink)]
+            .into_iter()
+            .flatten()
+            .next();
+        let Some((a, b)) = pair else {
+            table.end = Some(format!(
+                "impact {k0}: peaks {k0} and {k1} are not read alike (both by the contact model at the noise, both resolved extremes or both kinks), and a ratio of unlike readings carries their different biases"
+            ));
+            break;
+        };
+        match late_coefficient(k0, w[0].apex_mm, a, b, e_h, geo, MAX_LATE_R_U) {
+            Ok(coefficient) => added.push((coefficient, a, b)),
+            Err(why) => {
+                table.end = Some(why);
+                break;
+            }
+        }
+    }
+    if table.end.is_none() {
+        table.end = Some(no_later_peak(table.impacts.len() + added.len()));
+    }
+    let crossings: Vec<(usize, f64)> = late.iter().map(|p| (p.k, p.crossing_s)).collect();
     append_late(table, &added, &crossings);
 }
 
@@ -191,35 +251,179 @@ pub fn extend_late(table: &mut ImpactTable, late: &[LatePeak], e_h: f64, geo: &G
 /// the noise; the list stops at the first impact without, with e > 1, or with
 /// u(r) above [`MAX_CONTACT_R_U`]. Uncertainties and correlations as
 /// [`extend_late`]'s.
-pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry) {
-    let Some(i0) = peaks.iter().position(|p| p.k == table.impacts.len()) else {
+pub fn extend_late_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], e_h: f64, geo: &Geometry, arc: Option<(f64, f64)>) {
+    let from = table.impacts.len();
+    extend_contacts_from(table, peaks, from, e_h, geo, arc, false, false);
+}
+
+/// The impacts from impact `from` on from contact readings (see
+/// [`extend_late_contacts`]); two-sided walls (`two_sided`): every half-cycle
+/// is a free arc, and the cap of u(r) is [`MAX_LATE_R_U`].
+#[allow(clippy::too_many_arguments)]
+fn extend_contacts_from(
+    table: &mut ImpactTable,
+    peaks: &[ContactPeak],
+    from: usize,
+    e_h: f64,
+    geo: &Geometry,
+    arc: Option<(f64, f64)>,
+    two_sided: bool,
+    skip: bool,
+) {
+    let Some(i0) = peaks.iter().position(|p| p.k == from) else {
         return;
     };
     let peaks = &peaks[i0..];
+    let cap = if two_sided { MAX_LATE_R_U } else { MAX_CONTACT_R_U };
     let mut added: Vec<(ImpactCoefficient, Reading, Reading)> = Vec::new();
     for w in peaks.windows(2) {
-        let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
-        let (Some(a), Some(b)) = (read(&w[0]), read(&w[1])) else {
-            let unread = if read(&w[0]).is_none() { w[0].k } else { w[1].k };
-            table.end = Some(format!(
-                "impact {}: peak {unread} has no reading of the contact model that fits the samples to the noise",
-                w[0].k
-            ));
+        // One-sided, the free arcs are the outward half-cycles (k even); the
+        // inward ones push into the transverse walls.
+        let free_arc = arc.filter(|_| two_sided || w[1].k.is_multiple_of(2));
+        if let Some(why) = free_arc.and_then(|arc| not_rocking(w[0].k, w[1].apex_mm, w[1].crossing_s - w[0].crossing_s, arc, geo)) {
+            table.end.get_or_insert(why);
             break;
+        }
+        let read = |p: &ContactPeak| p.reading.filter(|r| r.fits_noise()).map(|r| r.reading);
+        let pair = match (read(&w[0]), read(&w[1])) {
+            (Some(a), Some(b)) => late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, cap).map(|c| (c, a, b)),
+            (a, _) => Err(format!(
+                "impact {}: peak {} has no reading of the contact model that fits the samples to the noise",
+                w[0].k,
+                if a.is_none() { w[0].k } else { w[1].k }
+            )),
         };
-        match late_coefficient(w[0].k, w[0].apex_mm, a, b, e_h, geo, MAX_CONTACT_R_U) {
-            Ok(c) => added.push((c, a, b)),
+        match pair {
+            Ok(p) => added.push(p),
             Err(why) => {
-                table.end = Some(why);
-                break;
+                table.end.get_or_insert(why);
+                if !skip {
+                    break;
+                }
             }
         }
     }
     if table.end.is_none() {
-        table.end = Some(no_later_peak(table.impacts.len() + added.len()));
+        table.end = Some(no_later_peak(from + added.len()));
     }
-    let crossings: Vec<f64> = peaks.iter().map(|p| p.crossing_s).collect();
+    let crossings: Vec<(usize, f64)> = peaks.iter().map(|p| (p.k, p.crossing_s)).collect();
     append_late(table, &added, &crossings);
+}
+
+/// A flagged test's impacts read by the contact model alone, from impact 1 on
+/// (a test the table's global fit cannot vouch for: its impacts are not read
+/// from that fit, and impact 0, the release arc's end, is not read by the
+/// contact model): the readings of [`extend_late_contacts`] (one-sided) or
+/// the contact pairs of [`extend_late_two_sided`] (two-sided), with their
+/// stops. docs/restitution-law.md says what they are worth.
+pub fn local_impacts(peaks: &[ContactPeak], e_h: f64, geo: &Geometry, arc: (f64, f64), two_sided: bool) -> ImpactTable {
+    let mut table = ImpactTable {
+        r_cov: Some(Vec::new()),
+        ..ImpactTable::default()
+    };
+    extend_contacts_from(&mut table, peaks, 1, e_h, geo, Some(arc), two_sided, true);
+    table
+}
+
+/// One-sided walls: the table's impacts 1 … n − 2 read again by the contact
+/// model. The global fit reads a one-sided wall's early impacts with one
+/// contact shape per direction, and its u(r) there reaches 0.05–0.11 (the
+/// MuJoCo campaigns' impacts 3 and 4); the contact model's ratios of its early
+/// peaks erred by RMS 0.006–0.016 on the public, hold-out and fresh one-sided
+/// campaigns (docs/restitution-law.md). Impact k is read again where both
+/// peaks' contact readings fit the samples to the noise, their r's u is at
+/// most [`MAX_CONTACT_R_U`] and below the table's own u(r): the better
+/// supported of two readings of the same impact, each a ratio of two readings
+/// of one kind. Impact 0 (the release arc's end, which the contact model does
+/// not read) and the late impacts keep theirs. A re-read impact's covariance is
+/// its own u² (the global fit's and the contact model's readings are
+/// independent), with the negative correlation of a neighbour that shares its
+/// contact reading of a peak; its raw speeds are the readings'.
+pub fn reread_contacts(table: &mut ImpactTable, peaks: &[ContactPeak], n_table: usize, e_h: f64, geo: &Geometry) {
+    let read = |k: usize| {
+        peaks
+            .iter()
+            .find(|p| p.k == k)
+            .and_then(|p| p.reading.filter(|r| r.fits_noise()).map(|r| (p.apex_mm, r.reading)))
+    };
+    let mut used: Vec<(usize, Reading, Reading)> = Vec::new();
+    for k in 1..n_table.saturating_sub(1).min(table.impacts.len()) {
+        let (Some((apex, a)), Some((_, b))) = (read(k), read(k + 1)) else {
+            continue;
+        };
+        let Ok(c) = late_coefficient(k, apex, a, b, e_h, geo, MAX_CONTACT_R_U) else {
+            continue;
+        };
+        let old = table.impacts[k];
+        if old.r_u.is_some_and(|u| c.r_u.unwrap_or(f64::INFINITY) >= u) {
+            continue;
+        }
+        table.impacts[k] = ImpactCoefficient {
+            amplitude_over_alpha: old.amplitude_over_alpha,
+            ..c
+        };
+        if let Some(raw) = table.raw.get_mut(k) {
+            raw.v_before_mm_s = a.velocity_mm_s;
+            raw.v_after_mm_s = Some(b.velocity_mm_s);
+        }
+        used.push((k, a, b));
+    }
+    let Some(cov) = table.r_cov.as_mut() else { return };
+    for &(k, _, _) in &used {
+        cov[k].iter_mut().for_each(|x| *x = 0.0);
+        for row in cov.iter_mut() {
+            row[k] = 0.0;
+        }
+        cov[k][k] = table.impacts[k].r_u.unwrap_or(0.0).powi(2);
+    }
+    for &(k, _, b) in &used {
+        let next = table.impacts.get(k + 1).copied();
+        let shares =
+            used.iter().any(|u| u.0 == k + 1 && u.1 == b) || (k + 2 == n_table && next.is_some_and(|n| n.speed_before_mm_s == b.velocity_mm_s.abs()));
+        if let (true, Some(d)) = (shares, next) {
+            let v = b.velocity_mm_s.abs();
+            let x = (table.impacts[k].r / v) * (-d.r / v) * b.u_mm_s * b.u_mm_s;
+            cov[k][k + 1] = x;
+            cov[k + 1][k] = x;
+        }
+    }
+}
+
+/// How much longer than the free rocking arc of its apex a half-cycle may last
+/// and still be free rocking ([`not_rocking`]).
+pub const MAX_ARC_RATIO: f64 = 1.1;
+
+/// Why impact k is not a rocking impact, if it is not: the half-cycle after it
+/// (apex `apex_mm`, lasting `duration_s`) is no free rocking arc. The rigid
+/// block's free arc of amplitude a = θ_apex/α (paper Eq. 1 linearised near
+/// θ = 0, θ'' = q² (θ ∓ α)) goes from the rest line to its apex and back in
+///
+///   T(a) = (2/q) arcosh(1/(1 − a)),
+///
+/// which falls to 0 with a; a wall that no longer lifts off vibrates on its
+/// bedding at the bedding's own period, whatever its amplitude. `arc` = (q in
+/// s⁻¹, L tan α in mm) as the log's own fit found them
+/// ([`crate::peaks::Analysis::small_arc`]). Measured on the MuJoCo campaigns
+/// (docs/restitution-law.md): T/T(a) = 1.00–1.01 while an edge lifts off for
+/// ≥ 80 % of the half-cycle, 1.03–1.13 as the lift-off fades (0.3–0.7 of
+/// it), 1.11–2.31 once it stops; above [`MAX_ARC_RATIO`] the wall is taken as
+/// no longer rocking and its velocity ratios, which then follow the bedding's
+/// damping, are not reported as coefficients of restitution.
+pub fn not_rocking(k: usize, apex_mm: f64, duration_s: f64, arc: (f64, f64), geo: &Geometry) -> Option<String> {
+    let alpha = (arc.1 / geo.lever_arm_mm).atan();
+    let a = (apex_mm / geo.lever_arm_mm).clamp(0.0, 1.0).asin() / alpha;
+    if !(a > 0.0 && a < 1.0 && arc.0 > 0.0 && duration_s > 0.0) {
+        return None;
+    }
+    let rigid = 2.0 / arc.0 * (1.0 / (1.0 - a)).acosh();
+    let ratio = duration_s / rigid;
+    (ratio > MAX_ARC_RATIO).then(|| {
+        format!(
+            "impact {k}: the half-cycle after it lasts {:.0} ms, {ratio:.2} × the free rocking arc of its amplitude a = {a:.4} ({:.0} ms): the wall no longer rocks (it vibrates on its bedding), and its velocity ratios are no coefficients of restitution",
+            duration_s * 1e3,
+            rigid * 1e3
+        )
+    })
 }
 
 /// The end of a list that ran out of read peaks: impact k is the first without.
@@ -255,9 +459,10 @@ fn late_coefficient(k: usize, apex_mm: f64, a: Reading, b: Reading, e_h: f64, ge
 }
 
 /// Appends the late impacts, their covariance block and their raw impacts;
-/// `crossings[i]` ends the half-cycle of the i-th added impact (one more for
-/// the last one's next peak).
-fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], crossings: &[f64]) {
+/// `crossings` gives the crossing that ends half-cycle k, (k, time), for every
+/// added impact's k and the last one's k + 1.
+fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Reading)], crossings: &[(usize, f64)]) {
+    let crossing = |k: usize| crossings.iter().find(|c| c.0 == k).map_or(f64::NAN, |c| c.1);
     if added.is_empty() {
         return;
     }
@@ -282,10 +487,10 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
         }
     }
     table.raw.truncate(n0);
-    for (i, (c, a, b)) in added.iter().enumerate() {
+    for (c, a, b) in added {
         table.raw.push(Impact {
             k: c.k,
-            time_s: crossings[i],
+            time_s: crossing(c.k),
             entering: c.side,
             v_before_mm_s: a.velocity_mm_s,
             v_after_mm_s: Some(b.velocity_mm_s),
@@ -295,7 +500,7 @@ fn append_late(table: &mut ImpactTable, added: &[(ImpactCoefficient, Reading, Re
         let next = c.k + 1;
         table.raw.push(Impact {
             k: next,
-            time_s: crossings[added.len()],
+            time_s: crossing(next),
             entering: if next % 2 == 0 { Side::Inward } else { Side::Outward },
             v_before_mm_s: b.velocity_mm_s,
             v_after_mm_s: None,
@@ -482,7 +687,7 @@ mod tests {
         };
         table.impacts.push(impact_stub(1));
         table.r_cov = Some(vec![vec![1e-4, 0.0], vec![0.0, 1e-4]]);
-        extend_late_contacts(&mut table, &peaks, 1.0, &geo);
+        extend_late_contacts(&mut table, &peaks, 1.0, &geo, None);
         let ks: Vec<usize> = table.impacts.iter().map(|i| i.k).collect();
         assert_eq!(ks, [0, 1, 2], "impact 2 from peaks 2 and 3; peak 4 does not fit");
         assert!((table.impacts[2].r - 70.0 / 80.0).abs() < 1e-12);
@@ -493,8 +698,125 @@ mod tests {
         );
         // Starting past the table: nothing added.
         let mut short = ImpactTable::default();
-        extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo);
+        extend_late_contacts(&mut short, &peaks[1..], 1.0, &geo, None);
         assert!(short.impacts.is_empty());
+    }
+
+    /// [`extend_late_two_sided`]: a contact pair at the noise first, then two
+    /// resolved extremes, then two kinks; a peak with no reading of a kind its
+    /// neighbour has ends the list.
+    #[test]
+    fn two_sided_late_impacts_prefer_the_contact_model() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 1000.0,
+            alpha_rad: 0.1,
+        };
+        let late_peaks = [
+            late(5, -100.0, true, true),
+            late(6, 90.0, true, true),
+            late(7, -80.0, false, true),
+            late(8, 70.0, false, false),
+            late(9, -60.0, true, false),
+        ];
+        // Contact readings: peaks 5–7 at the noise, 8 not, 9 at the noise.
+        let contacts = [
+            contact(5, -99.0, true),
+            contact(6, 89.0, true),
+            contact(7, -79.0, true),
+            contact(8, 69.0, false),
+            contact(9, -59.0, true),
+        ];
+        let mut table = ImpactTable {
+            impacts: (0..5).map(impact_stub).collect(),
+            r_cov: Some(vec![vec![0.0; 5]; 5]),
+            ..ImpactTable::default()
+        };
+        extend_late_two_sided(&mut table, &late_peaks, &contacts, 1.0, &geo, None);
+        let ks: Vec<usize> = table.impacts.iter().map(|i| i.k).collect();
+        // 5, 6: contact pairs; 7: contact 8 is not at the noise and peak 8 has
+        // neither a resolved extreme nor a kink: the list ends.
+        assert_eq!(ks, [0, 1, 2, 3, 4, 5, 6]);
+        assert!((table.impacts[5].r - 89.0 / 99.0).abs() < 1e-12);
+        assert!((table.impacts[6].r - 79.0 / 89.0).abs() < 1e-12);
+        assert!(
+            table.end.as_deref().unwrap().starts_with("impact 7: peaks 7 and 8 are not read alike"),
+            "{:?}",
+            table.end
+        );
+        let cov = table.r_cov.as_ref().unwrap();
+        assert!(cov[5][6] < 0.0, "impacts 5 and 6 share the contact reading of peak 6");
+        assert_eq!(table.raw.len(), 3, "raw impacts 5, 6 and the next peak's");
+        // Without contact readings: the resolved extremes of 5 and 6, then
+        // kinks of 6 and 7, then no pair for 7 and 8.
+        let mut plain = ImpactTable {
+            impacts: (0..5).map(impact_stub).collect(),
+            ..ImpactTable::default()
+        };
+        extend_late_two_sided(&mut plain, &late_peaks, &[], 1.0, &geo, None);
+        assert_eq!(plain.impacts.len(), 7);
+        assert!((plain.impacts[6].r - 80.0 / 90.0).abs() < 1e-12, "the kinks' ratio (both 1.01 × v)");
+    }
+
+    /// [`reread_contacts`]: a one-sided table impact is read again by the
+    /// contact model where both peaks' readings fit the noise and its u(r) is
+    /// below the table's; its covariance row is its own, with the neighbour
+    /// that shares a contact reading.
+    #[test]
+    fn one_sided_table_impacts_are_read_again_where_the_contact_model_is_better() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 1000.0,
+            alpha_rad: 0.1,
+        };
+        let mut table = ImpactTable {
+            impacts: (0..5).map(impact_stub).collect(),
+            r_cov: Some((0..5).map(|i| (0..5).map(|j| if i == j { 1e-4 } else { 5e-5 }).collect()).collect()),
+            ..ImpactTable::default()
+        };
+        // u(r) of the contact pairs ≈ 0.9 × √2 × 0.01 ≈ 0.0127 > the table's 0.01
+        // for impact 1; the table's u of impacts 2 and 3 made worse.
+        table.impacts[2].r_u = Some(0.05);
+        table.impacts[3].r_u = Some(0.05);
+        let peaks = [
+            contact(1, 90.0, true),
+            contact(2, -80.0, true),
+            contact(3, 70.0, true),
+            contact(4, -60.0, true),
+            contact(5, 50.0, false),
+        ];
+        reread_contacts(&mut table, &peaks, 6, 1.0, &geo);
+        assert_eq!(table.impacts[1].r, 0.9, "the table's u is smaller: kept");
+        assert!((table.impacts[2].r - 70.0 / 80.0).abs() < 1e-12);
+        assert!((table.impacts[3].r - 60.0 / 70.0).abs() < 1e-12);
+        assert_eq!(table.impacts[4].r, 0.9, "peak 5 is not at the noise: kept");
+        assert_eq!(table.impacts[2].amplitude_over_alpha, 0.1, "the table's amplitude");
+        let cov = table.r_cov.as_ref().unwrap();
+        assert_eq!(cov[1][2], 0.0);
+        assert_eq!(cov[3][4], 0.0);
+        assert!(cov[2][3] < 0.0, "impacts 2 and 3 share the contact reading of peak 3");
+        assert!((cov[2][2].sqrt() - table.impacts[2].r_u.unwrap()).abs() < 1e-15);
+        assert_eq!(cov[0][1], 5e-5, "the table's own covariance elsewhere");
+    }
+
+    /// [`not_rocking`]: a half-cycle as long as the free rocking arc of its
+    /// amplitude, T(a) = (2/q) arcosh(1/(1 − a)), is rocking; one 1.2 × as long
+    /// is not, and says so.
+    #[test]
+    fn a_half_cycle_longer_than_the_free_arc_is_not_rocking() {
+        let geo = Geometry {
+            time_s: &[],
+            lever_arm_mm: 2000.0,
+            alpha_rad: 0.2,
+        };
+        let (q, centre) = (2.5, 2000.0 * 0.2f64.tan());
+        let apex = 2000.0 * (0.05f64 * 0.2).sin();
+        let t = 2.0 / q * (1.0f64 / 0.95).acosh();
+        assert!(not_rocking(3, apex, t, (q, centre), &geo).is_none());
+        assert!(not_rocking(3, apex, 1.05 * t, (q, centre), &geo).is_none());
+        let why = not_rocking(3, apex, 1.2 * t, (q, centre), &geo).expect("not rocking");
+        assert!(why.starts_with("impact 3: the half-cycle after it lasts"), "{why}");
+        assert!(why.contains("1.20 ×") && why.contains("a = 0.0500"), "{why}");
     }
 
     fn impact_stub(k: usize) -> ImpactCoefficient {

@@ -3,8 +3,8 @@
 //! and their uncertainties. The log arrives already read ([`crate::ingest`] reads
 //! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
 
-use crate::impacts::{extend_late, extend_late_contacts, impact_table, Geometry, ImpactTable};
-use crate::peaks::late::{contact_peaks, nominal_arc, CONTACT_POST_S};
+use crate::impacts::{extend_late_contacts, extend_late_two_sided, impact_table, reread_contacts, Geometry, ImpactTable};
+use crate::peaks::late::{arc_contact_peaks, contact_peaks, nominal_arc, CONTACT_POST_S};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
 use crate::restitution::{coefficients, uncertainties, unresolved_reason, Coefficients};
 use crate::wall::{Rocking, Wall};
@@ -116,21 +116,18 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
     let mut table = impact_table(&red.analysis, &geo, e_housner);
     let n = red.analysis.peaks.len();
     if options.method == crate::peaks::Method::Segments && red.analysis.quality.is_ok() && n >= 2 {
+        let arc = red
+            .analysis
+            .small_arc
+            .unwrap_or_else(|| nominal_arc(phys.p_guess, alpha_rad, phys.lever_arm_mm));
         if phys.rocking == crate::wall::Rocking::TwoSided {
             let late = red.analysis.late_peaks(&red.log.time_s, phys.lever_arm_mm, n - 1, MAX_IMPACT_PEAKS);
-            extend_late(&mut table, &late, e_housner, &geo, true);
+            let contacts = arc_contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S);
+            extend_late_two_sided(&mut table, &late, &contacts, e_housner, &geo, Some(arc));
         } else {
-            let contacts = contact_peaks(
-                &red.analysis,
-                &red.log.time_s,
-                phys.lever_arm_mm,
-                red.analysis
-                    .small_arc
-                    .unwrap_or_else(|| nominal_arc(phys.p_guess, alpha_rad, phys.lever_arm_mm)),
-                MAX_IMPACT_PEAKS,
-                CONTACT_POST_S,
-            );
-            extend_late_contacts(&mut table, &contacts, e_housner, &geo);
+            let contacts = contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S);
+            extend_late_contacts(&mut table, &contacts, e_housner, &geo, Some(arc));
+            reread_contacts(&mut table, &contacts, n, e_housner, &geo);
         }
     }
     if table.end.is_some() && table.impacts.len() + 1 >= MAX_IMPACT_PEAKS {

@@ -141,8 +141,9 @@ fn law_vs_truth(law: &rocklab::restitution_law::RestitutionLaw, res: &CampaignRe
 
 /// Two-sided compliant contacts. Asserted: every impact reported within RMS 0.015 of
 /// the truth (the bound); the law within RMS 0.02 of the truth over every
-/// listed impact (the bound; measured 0.0149 since the fit adds the form's
-/// own misfit τ to every u, 0.0235 with the bare u) and closer than the best
+/// listed impact (the bound; measured 0.0124 with the contact model's late
+/// impacts and the stop where the wall no longer rocks, 0.0149 before them, 0.0235
+/// with the bare u before the fit added the form's own misfit τ to every u) and closer than the best
 /// constant pair; the data reject the constant. Also printed: the same fit to the
 /// truth's own r with the readings' u (what the weighting alone gives):
 /// docs/restitution-law.md.
@@ -192,7 +193,7 @@ fn mujoco_two_sided_impacts_and_law() {
 /// One-sided compliant contacts. The impacts after the table's five are read
 /// with the contact model (src/peaks/late.rs, `contact_peaks`). Asserted: at
 /// least 80 % of the listed impacts reported (94 % when written: 31 of 33), the
-/// per-impact RMS within the 0.015 (0.0137 when written; the late
+/// per-impact RMS within the 0.015 (0.0123 when written, 0.0137 and 0.0125 before; the late
 /// readings with the contact model, docs/restitution-law.md), and
 /// the law from them closer to the truth than the best constant pair (0.0287
 /// against 0.0537 when written; the same law fitted to the truth's own r:
@@ -723,8 +724,9 @@ fn mujoco_law_by_replay() {
 /// every listed impact (`truth_listed`: velocity-peak ratios while the wall lifts
 /// off), beside the best constant pair of those impacts; likewise the campaign
 /// directories in `FRESH_CAMPAIGNS` (colon-separated; `python3
-/// tools/mujoco_campaign.py --preset fresh-two-sided --out DIR`). Printed, not
-/// asserted (docs/restitution-law.md). Ignored: two reductions or more.
+/// tools/mujoco_campaign.py --preset fresh-two-sided --out DIR`). Printed; the
+/// hold-outs' laws asserted closer than the constant pair, the two-sided one
+/// within 0.05 (docs/restitution-law.md). Ignored: two reductions or more.
 #[test]
 #[ignore]
 fn holdout_law_from_readings() {
@@ -766,6 +768,17 @@ fn holdout_law_from_readings() {
                 part.len(),
                 rms(&part)
             );
+        }
+        // The "closer than the best constant pair" on the MuJoCo
+        // hold-outs (0.0440 against 0.1256 two-sided, 0.0385 against 0.0446
+        // one-sided when written), and the two-sided law within 0.05 (0.0440
+        // when written, 0.0600 before the R3 session; the speed-loss form fitted
+        // to the truth's own r reaches 0.0414 there).
+        if name.starts_with("mujoco-holdout") {
+            assert!(rms(&err) < rms(&cst), "{name}: law {:.4} vs constant {:.4}", rms(&err), rms(&cst));
+        }
+        if name == "mujoco-holdout-two-sided" {
+            assert!(rms(&err) <= 0.05, "{name}: law {:.4}", rms(&err));
         }
         println!(
             "{name}: law from the readings ({:?}, {:?}) RMS {:.4} over {} listed impacts; best constant pair {:.4}; sides {:?}",

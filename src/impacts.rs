@@ -565,6 +565,14 @@ fn apex(a: &Analysis, geo: &Geometry, k: usize) -> f64 {
 mod tests {
     use super::*;
 
+    /// The geometry of the pairing tests: no samples (their readings are given),
+    /// L = 1 m, α = 0.1.
+    const NO_LOG: Geometry<'static> = Geometry {
+        time_s: &[],
+        lever_arm_mm: 1000.0,
+        alpha_rad: 0.1,
+    };
+
     fn late(k: usize, v: f64, smooth: bool, kink: bool) -> LatePeak {
         let reading = |x: f64| Reading {
             time_s: k as f64,
@@ -585,11 +593,7 @@ mod tests {
     /// pair ends the list; consecutive ratios sharing a reading are correlated.
     #[test]
     fn late_impacts_pair_readings_of_one_kind() {
-        let geo = Geometry {
-            time_s: &[],
-            lever_arm_mm: 1000.0,
-            alpha_rad: 0.1,
-        };
+        let geo = NO_LOG;
         let peaks = [
             late(0, -100.0, true, true),
             late(1, 90.0, true, true),
@@ -668,11 +672,7 @@ mod tests {
     /// the first that does not.
     #[test]
     fn late_contacts_pair_readings_that_fit() {
-        let geo = Geometry {
-            time_s: &[],
-            lever_arm_mm: 1000.0,
-            alpha_rad: 0.1,
-        };
+        let geo = NO_LOG;
         let peaks = [
             contact(1, 90.0, true),
             contact(2, -80.0, true),
@@ -707,11 +707,7 @@ mod tests {
     /// neighbour has ends the list.
     #[test]
     fn two_sided_late_impacts_prefer_the_contact_model() {
-        let geo = Geometry {
-            time_s: &[],
-            lever_arm_mm: 1000.0,
-            alpha_rad: 0.1,
-        };
+        let geo = NO_LOG;
         let late_peaks = [
             late(5, -100.0, true, true),
             late(6, 90.0, true, true),
@@ -764,11 +760,7 @@ mod tests {
     /// that shares a contact reading.
     #[test]
     fn one_sided_table_impacts_are_read_again_where_the_contact_model_is_better() {
-        let geo = Geometry {
-            time_s: &[],
-            lever_arm_mm: 1000.0,
-            alpha_rad: 0.1,
-        };
+        let geo = NO_LOG;
         let mut table = ImpactTable {
             impacts: (0..5).map(impact_stub).collect(),
             r_cov: Some((0..5).map(|i| (0..5).map(|j| if i == j { 1e-4 } else { 5e-5 }).collect()).collect()),

@@ -793,19 +793,38 @@ pub fn nominal_arc(p: f64, alpha_rad: f64, lever_mm: f64) -> (f64, f64) {
     (p * alpha_rad.cos().sqrt(), lever_mm * alpha_rad.tan())
 }
 
+/// The log's zero crossings after the release (up to `max_peaks`) and the arc
+/// length y = L asin(x/L) (mm) the contact model reads; `None` for a log too
+/// short or whose displacement does not match its times.
+fn crossings_and_arc(a: &super::Analysis, t: &[f64], lever_mm: f64, max_peaks: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+    if t.len() < 3 || t.len() != a.displacement_mm.len() {
+        return None;
+    }
+    let departure = t.partition_point(|&v| v < a.release_time_s).min(t.len() - 1);
+    let c = super::crossings::find_crossings(t, &a.displacement_mm, 0.0, a.noise_mm, departure, max_peaks);
+    let y = a
+        .displacement_mm
+        .iter()
+        .map(|&v| lever_mm * (v / lever_mm).clamp(-1.0, 1.0).asin())
+        .collect();
+    Some((c, y))
+}
+
+/// max |x| over the samples with from ≤ t ≤ to (the half-cycle's apex, mm).
+fn apex_between(t: &[f64], x: &[f64], from: f64, to: f64) -> f64 {
+    let (i0, i1) = (t.partition_point(|&v| v < from), t.partition_point(|&v| v <= to));
+    x[i0..i1].iter().map(|v| v.abs()).fold(0.0, f64::max)
+}
+
 /// Peaks 1 … `max_peaks − 1` of a one-sided log read with the contact model:
 /// k even ends a free arc on the base ([`FreeMotion::Rocking`] with `arc` =
 /// (rate s⁻¹, centre mm): the global fit's [`super::Analysis::small_arc`], so
 /// that a wall whose geometry is not the manifest's is read with its own), k
 /// odd a push into the transverse walls (the test's restraint, [`restraint_of`]).
 pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f64), max_peaks: usize, post_s: f64) -> Vec<ContactPeak> {
-    if t.len() < 3 || t.len() != a.displacement_mm.len() {
+    let Some((c, y)) = crossings_and_arc(a, t, lever_mm, max_peaks) else {
         return Vec::new();
-    }
-    let departure = t.partition_point(|&v| v < a.release_time_s).min(t.len() - 1);
-    let c = super::crossings::find_crossings(t, &a.displacement_mm, 0.0, a.noise_mm, departure, max_peaks);
-    let x = &a.displacement_mm;
-    let y: Vec<f64> = x.iter().map(|&v| lever_mm * (v / lever_mm).clamp(-1.0, 1.0).asin()).collect();
+    };
     let inward: Vec<(f64, f64)> = (1..c.len()).filter(|k| k % 2 == 1).map(|k| (c[k - 1], c[k])).collect();
     let restraint = restraint_of(t, &y, &inward, post_s, a.noise_mm);
     let arc = FreeMotion::Rocking {
@@ -820,11 +839,10 @@ pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f
             } else {
                 restraint.map(|(lambda, omega)| FreeMotion::Restraint { lambda, omega })
             };
-            let (i0, i1) = (t.partition_point(|&v| v < c[k - 1]), t.partition_point(|&v| v <= c[k]));
             ContactPeak {
                 k,
                 crossing_s: c[k],
-                apex_mm: x[i0..i1].iter().map(|v| v.abs()).fold(0.0, f64::max),
+                apex_mm: apex_between(t, &a.displacement_mm, c[k - 1], c[k]),
                 reading: m.and_then(|m| read_contact(t, &y, (c[k - 1], ONE_SIDED_FROM), c[k], post_s, m, a.noise_mm, want)),
             }
         })
@@ -839,13 +857,9 @@ pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f
 /// contact's force from its onset, as the free arc of a one-sided wall
 /// ([`contact_peaks`]).
 pub fn arc_contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f64), max_peaks: usize, post_s: f64) -> Vec<ContactPeak> {
-    if t.len() < 3 || t.len() != a.displacement_mm.len() {
+    let Some((c, y)) = crossings_and_arc(a, t, lever_mm, max_peaks) else {
         return Vec::new();
-    }
-    let departure = t.partition_point(|&v| v < a.release_time_s).min(t.len() - 1);
-    let c = super::crossings::find_crossings(t, &a.displacement_mm, 0.0, a.noise_mm, departure, max_peaks);
-    let x = &a.displacement_mm;
-    let y: Vec<f64> = x.iter().map(|&v| lever_mm * (v / lever_mm).clamp(-1.0, 1.0).asin()).collect();
+    };
     (1..c.len())
         .map(|k| {
             let want = if k % 2 == 0 { -1.0 } else { 1.0 };
@@ -853,11 +867,10 @@ pub fn arc_contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f6
                 rate: arc.0,
                 centre_mm: -want * arc.1,
             };
-            let (i0, i1) = (t.partition_point(|&v| v < c[k - 1]), t.partition_point(|&v| v <= c[k]));
             ContactPeak {
                 k,
                 crossing_s: c[k],
-                apex_mm: x[i0..i1].iter().map(|v| v.abs()).fold(0.0, f64::max),
+                apex_mm: apex_between(t, &a.displacement_mm, c[k - 1], c[k]),
                 reading: read_contact(t, &y, (c[k - 1], TWO_SIDED_FROM), c[k], post_s, m, a.noise_mm, want),
             }
         })

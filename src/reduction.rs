@@ -74,15 +74,7 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
     let c = coefficients(&v, e_housner).ok_or(ReduceError::TooFewPeaks { found: v.len() })?;
     let u = analysis.peak_covariance.as_ref().and_then(|cov| uncertainties(&v, cov, e_housner));
     if let (Some(u), Some(cov)) = (&u, &analysis.peak_covariance) {
-        if let Some(why) = unresolved_reason(u, &v, cov) {
-            analysis.quality = match analysis.quality {
-                Quality::Ok => Quality::Suspect(vec![why]),
-                Quality::Suspect(mut r) => {
-                    r.push(why);
-                    Quality::Suspect(r)
-                }
-            };
-        }
+        analysis.quality = analysis.quality.with(unresolved_reason(u, &v, cov));
     }
     Ok(Reduced {
         log,

@@ -894,14 +894,7 @@ pub fn contact_check_with_trend(kind: Generic, cutoff_hz: f64, peaks: &[f64], ot
 /// The verdict of the checks with [`family_check`]'s reason added, if any.
 pub(super) fn with_family_check(verdict: super::Quality, est: Option<&Estimate>, peaks: &[super::Peak]) -> super::Quality {
     let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
-    match (verdict, est.and_then(|e| family_check(e, &v))) {
-        (q, None) => q,
-        (super::Quality::Ok, Some(why)) => super::Quality::Suspect(vec![why]),
-        (super::Quality::Suspect(mut r), Some(why)) => {
-            r.push(why);
-            super::Quality::Suspect(r)
-        }
-    }
+    verdict.with(est.and_then(|e| family_check(e, &v)))
 }
 
 #[cfg(test)]

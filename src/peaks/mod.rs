@@ -325,6 +325,18 @@ impl Quality {
     pub fn is_ok(&self) -> bool {
         matches!(self, Quality::Ok)
     }
+    /// This verdict with one more reason, if there is one (an ok verdict becomes
+    /// suspect).
+    pub fn with(self, why: Option<String>) -> Quality {
+        match (self, why) {
+            (q, None) => q,
+            (Quality::Ok, Some(why)) => Quality::Suspect(vec![why]),
+            (Quality::Suspect(mut r), Some(why)) => {
+                r.push(why);
+                Quality::Suspect(r)
+            }
+        }
+    }
     /// "ok", or "suspect: reason; reason".
     pub fn describe(&self) -> String {
         match self {

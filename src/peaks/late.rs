@@ -418,6 +418,16 @@ enum ContactShape {
     Ramp,
 }
 
+impl ContactShape {
+    /// The powers of s = (τ − τ_on)/h of the contact's two columns.
+    fn exponents(self) -> (i32, i32) {
+        match self {
+            ContactShape::Jump => (2, 3),
+            ContactShape::Ramp => (3, 4),
+        }
+    }
+}
+
 /// The row of the design matrix at τ and its time derivative: the free
 /// motion's [`FreeMotion::free_count`] columns, then the contact's two (the
 /// first `free_count + 2` entries are used).
@@ -426,16 +436,34 @@ fn contact_row(m: FreeMotion, shape: ContactShape, tau: f64, tau_on: f64) -> ([f
     let (f, df) = m.columns(tau);
     let nf = m.free_count();
     let s = (tau - tau_on).max(0.0) / h;
-    let q = if shape == ContactShape::Ramp { 1 } else { 0 };
-    let (a, b) = (2 + q, 3 + q);
+    let (a, b) = shape.exponents();
     let (mut row, mut d) = ([0.0; CONTACT_COLUMNS], [0.0; CONTACT_COLUMNS]);
     row[..nf].copy_from_slice(&f[..nf]);
     d[..nf].copy_from_slice(&df[..nf]);
-    row[nf] = s.powi(a);
-    row[nf + 1] = s.powi(b);
-    d[nf] = a as f64 * s.powi(a - 1) / h;
-    d[nf + 1] = b as f64 * s.powi(b - 1) / h;
+    row[nf] = powi_small(s, a);
+    row[nf + 1] = powi_small(s, b);
+    d[nf] = a as f64 * powi_small(s, a - 1) / h;
+    d[nf + 1] = b as f64 * powi_small(s, b - 1) / h;
     (row, d)
+}
+
+/// `s.powi(n)` for 0 ≤ n ≤ 4, bit for bit (the square-and-multiply of the
+/// runtime's `__powidf2` and of LLVM's expansion of a constant exponent: s³ =
+/// s · s², s⁴ = s² · s²), without its call: the contact columns' powers are
+/// the inner loop of [`restraint_of`]'s search (`powi_small_is_powi`).
+#[inline]
+fn powi_small(s: f64, n: i32) -> f64 {
+    match n {
+        0 => 1.0,
+        1 => s,
+        2 => s * s,
+        3 => s * (s * s),
+        4 => {
+            let s2 = s * s;
+            s2 * s2
+        }
+        _ => s.powi(n),
+    }
 }
 
 /// The free motion's columns at every sample of a window and their normal
@@ -450,6 +478,11 @@ struct FreeColumns<'a> {
     f: Vec<[f64; FREE_MAX]>,
     ftf: [[f64; FREE_MAX]; FREE_MAX],
     fty: [f64; FREE_MAX],
+    /// The largest |y| and |free column| of the window, and the largest s of
+    /// the contact's columns (at least 1): what bounds a residual.
+    y_max: f64,
+    f_max: f64,
+    s_max: f64,
 }
 
 impl<'a> FreeColumns<'a> {
@@ -466,7 +499,37 @@ impl<'a> FreeColumns<'a> {
                 }
             }
         }
-        FreeColumns { tau, y, nf, f, ftf, fty }
+        let y_max = y.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
+        let f_max = f.iter().flat_map(|fi| &fi[..nf]).fold(0.0, |a: f64, v| a.max(v.abs()));
+        let s_max = match (tau.first(), tau.last()) {
+            (Some(a), Some(b)) => ((b - a) / CONTACT_SCALE_S).max(1.0),
+            _ => 1.0,
+        };
+        FreeColumns {
+            tau,
+            y,
+            nf,
+            f,
+            ftf,
+            fty,
+            y_max,
+            f_max,
+            s_max,
+        }
+    }
+
+    /// Whether every residual of the fit `c` and their sum of squares over σ²
+    /// are surely finite (a bound with a margin of 4 for rounding): then a
+    /// χ² cut off by [`FreeColumns::chi2`]'s `stop` would have been finite,
+    /// a fit that counts.
+    fn finite_residuals(&self, shape: ContactShape, c: &DVector<f64>, sigma: f64) -> bool {
+        if !(c.iter().all(|v| v.is_finite()) && self.y_max.is_finite() && self.f_max.is_finite()) {
+            return false;
+        }
+        let c_max = c.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
+        let r = self.y_max + c_max * (self.nf as f64 * self.f_max + 2.0 * self.s_max.powi(shape.exponents().1));
+        let bound = 4.0 * self.tau.len() as f64 * (r * r) / (sigma * sigma);
+        bound.is_finite() && bound < f64::MAX / 4.0
     }
 
     /// The least-squares fit of the window with the contact's onset at τ_on:
@@ -474,12 +537,39 @@ impl<'a> FreeColumns<'a> {
     /// [`contact_row`]'s values, XᵀX c = Xᵀy, with the contact columns summed
     /// over the samples after the onset only; χ² from the residuals.
     fn fit(&self, shape: ContactShape, tau_on: f64, sigma: f64) -> Option<ContactFit> {
+        let (c, inv) = self.solve(shape, tau_on)?;
+        match self.chi2(shape, tau_on, &c, sigma, |_| false) {
+            Chi2::Done(chi2) => Some(ContactFit { shape, c, inv, chi2, tau_on }),
+            Chi2::Stopped | Chi2::NotFinite => None,
+        }
+    }
+
+    /// The coefficients and (XᵀX)⁻¹ of [`FreeColumns::fit`]; None where XᵀX
+    /// is singular. The sums are accumulated in the same order as they were in
+    /// the n × 5 matrix's entries (each entry its own running sum over the
+    /// samples), so that every output is the same to the bit.
+    fn solve(&self, shape: ContactShape, tau_on: f64) -> Option<(DVector<f64>, DMatrix<f64>)> {
         let h = CONTACT_SCALE_S;
-        let q = if shape == ContactShape::Ramp { 1 } else { 0 };
-        let (a, b) = (2 + q, 3 + q);
+        let (a, b) = shape.exponents();
         let from = self.tau.partition_point(|&v| v <= tau_on);
         let nf = self.nf;
         let nc = nf + 2;
+        // The contact columns' sums: with the free columns (fc), with each
+        // other (cc) and with y (cy).
+        let (mut fc, mut cc, mut cy) = ([[0.0f64; 2]; FREE_MAX], [[0.0f64; 2]; 2], [0.0f64; 2]);
+        for (fi, (&ti, &yi)) in self.f[from..].iter().zip(self.tau[from..].iter().zip(&self.y[from..])) {
+            let s = (ti - tau_on) / h;
+            let col = [powi_small(s, a), powi_small(s, b)];
+            for (k, &ck) in col.iter().enumerate() {
+                for j in 0..nf {
+                    fc[j][k] += fi[j] * ck;
+                }
+                for (l, &cl) in col.iter().enumerate() {
+                    cc[k][l] += ck * cl;
+                }
+                cy[k] += ck * yi;
+            }
+        }
         let mut g = DMatrix::<f64>::zeros(nc, nc);
         let mut rhs = DVector::<f64>::zeros(nc);
         for j in 0..nf {
@@ -487,40 +577,64 @@ impl<'a> FreeColumns<'a> {
             for l in 0..nf {
                 g[(j, l)] = self.ftf[j][l];
             }
-        }
-        for i in from..self.tau.len() {
-            let s = (self.tau[i] - tau_on) / h;
-            let cc = [s.powi(a), s.powi(b)];
-            let fi = &self.f[i];
-            for (k, &ck) in cc.iter().enumerate() {
-                for j in 0..nf {
-                    g[(j, nf + k)] += fi[j] * ck;
-                }
-                for (l, &cl) in cc.iter().enumerate() {
-                    g[(nf + k, nf + l)] += ck * cl;
-                }
-                rhs[nf + k] += ck * self.y[i];
+            for k in 0..2 {
+                g[(j, nf + k)] = fc[j][k];
+                g[(nf + k, j)] = fc[j][k];
             }
         }
-        for j in 0..nf {
-            for k in nf..nc {
-                g[(k, j)] = g[(j, k)];
+        for k in 0..2 {
+            rhs[nf + k] = cy[k];
+            for l in 0..2 {
+                g[(nf + k, nf + l)] = cc[k][l];
             }
         }
         let inv = g.try_inverse()?;
         let c = &inv * rhs;
+        Some((c, inv))
+    }
+
+    /// χ² of the fit `c` with the onset at τ_on, the residuals summed in the
+    /// samples' order; `stop` is asked of the partial χ² (which only grows)
+    /// every [`CHI2_CHECK`] samples, and `Stopped` returned once it says yes:
+    /// the full χ² is then at least that partial one.
+    fn chi2(&self, shape: ContactShape, tau_on: f64, c: &DVector<f64>, sigma: f64, stop: impl Fn(f64) -> bool) -> Chi2 {
+        let h = CONTACT_SCALE_S;
+        let (a, b) = shape.exponents();
+        let from = self.tau.partition_point(|&v| v <= tau_on);
+        let nf = self.nf;
+        let (cf, c_a, c_b) = ([c[0], c[1], if nf > 2 { c[2] } else { 0.0 }], c[nf], c[nf + 1]);
+        let s2 = sigma * sigma;
         let mut sum = 0.0;
         for (i, (fi, &yi)) in self.f.iter().zip(&self.y).enumerate() {
-            let mut model: f64 = (0..nf).map(|j| fi[j] * c[j]).sum();
+            let mut model: f64 = (0..nf).map(|j| fi[j] * cf[j]).sum();
             if i >= from {
                 let s = (self.tau[i] - tau_on) / h;
-                model += s.powi(a) * c[nf] + s.powi(b) * c[nf + 1];
+                model += powi_small(s, a) * c_a + powi_small(s, b) * c_b;
             }
             sum += (yi - model).powi(2);
+            if i % CHI2_CHECK == CHI2_CHECK - 1 && stop(sum / s2) {
+                return Chi2::Stopped;
+            }
         }
-        let chi2 = sum / (sigma * sigma);
-        chi2.is_finite().then_some(ContactFit { shape, c, inv, chi2, tau_on })
+        let chi2 = sum / s2;
+        if chi2.is_finite() {
+            Chi2::Done(chi2)
+        } else {
+            Chi2::NotFinite
+        }
     }
+}
+
+/// How often [`FreeColumns::chi2`] asks whether to stop (samples).
+const CHI2_CHECK: usize = 16;
+
+/// What [`FreeColumns::chi2`] found: the χ², that its caller's bound was
+/// passed (the χ² is at least that), or a χ² that is not finite.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Chi2 {
+    Done(f64),
+    Stopped,
+    NotFinite,
 }
 
 /// One fit of the window with the onset at τ_on, by the n × 5 design matrix
@@ -675,6 +789,12 @@ fn read_contact_on(
 /// exhaustive search). The exhaustive search's pair is found wherever it is
 /// among the coarse scores' best or next to one of them
 /// (`restraint_search_is_the_exhaustive_one`).
+///
+/// A pair whose score is sure to exceed a bound is left unscored (see
+/// [`RestraintGrid::score`]): in the coarse pass the [`FINE_PAIRS`]-th least
+/// score so far, in the fine pass the best so far. Neither can then be among
+/// the best: the pairs kept, their order and the pair found are those of
+/// every pair scored in full (`pruned_restraint_search_is_the_full_one`).
 pub fn restraint_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma: f64) -> Option<(f64, f64)> {
     let (windows, omega0) = restraint_windows(t, y, halves, post_s)?;
     let grid = RestraintGrid {
@@ -682,8 +802,12 @@ pub fn restraint_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, si
         omega0,
         sigma,
     };
-    let pairs: Vec<(usize, usize)> = (0..OMEGAS).flat_map(|i| (0..ZETAS).map(move |j| (i, j))).collect();
-    let mut coarse: Vec<(f64, (usize, usize))> = pairs.iter().map(|&ij| (grid.score(ij, COARSE_STRIDE), ij)).collect();
+    grid.best(near_best(grid.coarse()))
+}
+
+/// The best [`FINE_PAIRS`] of the coarse scores (a stable sort: ties to the
+/// first in grid order) and their neighbours on the grid, in grid order.
+fn near_best(mut coarse: Vec<(f64, (usize, usize))>) -> std::collections::BTreeSet<(usize, usize)> {
     coarse.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut near = std::collections::BTreeSet::new();
     for &(_, (i, j)) in coarse.iter().take(FINE_PAIRS) {
@@ -693,7 +817,7 @@ pub fn restraint_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, si
             }
         }
     }
-    grid.best(near.into_iter())
+    near
 }
 
 /// The (ω, ζ) grid of [`restraint_of`]: 25 ω, 11 ζ.
@@ -716,8 +840,79 @@ impl RestraintGrid<'_> {
         (0.05 * j as f64 * omega, omega)
     }
 
-    /// The summed best χ² over the windows, onsets every `stride` grid steps.
-    fn score(&self, ij: (usize, usize), stride: usize) -> f64 {
+    /// The coarse scores (onsets every [`COARSE_STRIDE`] steps) of every pair
+    /// in grid order but those sure to exceed the [`FINE_PAIRS`]-th least
+    /// score of the pairs before them: those are not among the best
+    /// [`FINE_PAIRS`] scores, nor ahead of them in a stable sort.
+    fn coarse(&self) -> Vec<(f64, (usize, usize))> {
+        let mut coarse = Vec::new();
+        // The least FINE_PAIRS scores so far, in order.
+        let mut least: Vec<f64> = Vec::with_capacity(FINE_PAIRS + 1);
+        for ij in (0..OMEGAS).flat_map(|i| (0..ZETAS).map(move |j| (i, j))) {
+            let bound = if least.len() < FINE_PAIRS {
+                f64::INFINITY
+            } else {
+                least[FINE_PAIRS - 1]
+            };
+            if let Some(total) = self.score(ij, COARSE_STRIDE, bound) {
+                coarse.push((total, ij));
+                let at = least.partition_point(|v| v.total_cmp(&total).is_le());
+                least.insert(at, total);
+                least.truncate(FINE_PAIRS);
+            }
+        }
+        coarse
+    }
+
+    /// The summed best χ² over the windows, onsets every `stride` grid steps,
+    /// or None where it is sure to exceed `bound` (f64::INFINITY: never).
+    /// Some(score) is the score to the bit ([`least_chi2`]): the windows' least
+    /// χ² summed in the windows' order. None is said once the running sum of
+    /// the windows' least χ² so far exceeds the bound, the χ² of every onset
+    /// of a window being cut off where the running sum plus its partial χ²
+    /// does (the sums only grow: the χ² are ≥ 0, and rounding is monotone).
+    fn score(&self, ij: (usize, usize), stride: usize, bound: f64) -> Option<f64> {
+        let (lambda, omega) = self.pair(ij);
+        let m = FreeMotion::Restraint { lambda, omega };
+        let mut mins = Vec::with_capacity(self.windows.len());
+        let mut running = 0.0;
+        for (tau, y) in self.windows {
+            match least_chi2(tau, y, m, ContactShape::Jump, self.sigma, stride, |x| running + x > bound) {
+                Least::Found(x) => {
+                    mins.push(x);
+                    running += x;
+                    if running > bound {
+                        return None;
+                    }
+                }
+                Least::NoFit => {}
+                Least::Above => return None,
+            }
+        }
+        let total: f64 = mins.iter().sum();
+        (total <= bound).then_some(total)
+    }
+
+    /// The pair of `points` (in (i, j) order) with the least score at every
+    /// onset; a pair whose score is sure to exceed the best so far is not
+    /// scored in full.
+    fn best(&self, points: impl IntoIterator<Item = (usize, usize)>) -> Option<(f64, f64)> {
+        let mut best: Option<(f64, (usize, usize))> = None;
+        for ij in points {
+            let bound = best.map_or(f64::INFINITY, |b| b.0);
+            if let Some(total) = self.score(ij, 1, bound) {
+                if best.is_none_or(|b| total < b.0) {
+                    best = Some((total, ij));
+                }
+            }
+        }
+        best.map(|b| self.pair(b.1))
+    }
+
+    /// The summed best χ² of every onset's fit (the reference of
+    /// [`RestraintGrid::score`]: no bound, every fit's χ² in full).
+    #[cfg(test)]
+    fn score_full(&self, ij: (usize, usize), stride: usize) -> f64 {
         let (lambda, omega) = self.pair(ij);
         let m = FreeMotion::Restraint { lambda, omega };
         self.windows
@@ -731,16 +926,72 @@ impl RestraintGrid<'_> {
             .sum()
     }
 
-    /// The pair of `points` (in (i, j) order) with the least score at every onset.
-    fn best(&self, points: impl Iterator<Item = (usize, usize)>) -> Option<(f64, f64)> {
+    /// [`RestraintGrid::best`] with every pair scored in full.
+    #[cfg(test)]
+    fn best_full(&self, points: impl IntoIterator<Item = (usize, usize)>) -> Option<(f64, f64)> {
         let mut best: Option<(f64, (usize, usize))> = None;
         for ij in points {
-            let total = self.score(ij, 1);
+            let total = self.score_full(ij, 1);
             if best.is_none_or(|b| total < b.0) {
                 best = Some((total, ij));
             }
         }
         best.map(|b| self.pair(b.1))
+    }
+}
+
+/// What [`least_chi2`] found for a window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Least {
+    /// The least χ² of the window's fits, to the bit.
+    Found(f64),
+    /// No fit (too few samples, or every fit singular or not finite).
+    NoFit,
+    /// Every fit was cut off by the caller's bound: the least χ² is above it.
+    Above,
+}
+
+/// The least χ² of [`contact_fits_every`]'s fits of a window (the first least,
+/// as `min_by`), without the fits: a fit's χ² is cut off once its partial sum
+/// reaches the least so far (it cannot be less) or once `above` says yes of it
+/// (the caller's bound: it is then above that too, and [`Least::Above`] is
+/// returned if no fit was below both). A χ² is only cut off where the fit's
+/// coefficients keep every residual finite, so that the fit would have counted.
+#[allow(clippy::too_many_arguments)]
+fn least_chi2(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigma: f64, stride: usize, above: impl Fn(f64) -> bool) -> Least {
+    if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
+        return Least::NoFit;
+    }
+    let first = tau[2.min(tau.len() - 1)].min(0.0);
+    let steps = (-first / ONSET_STEP_S).floor() as usize;
+    let free = FreeColumns::new(tau, y, m);
+    let mut least: Option<f64> = None;
+    let mut cut = false;
+    for i in (0..=steps).step_by(stride) {
+        let tau_on = -(i as f64) * ONSET_STEP_S;
+        let Some((c, _)) = free.solve(shape, tau_on) else {
+            continue;
+        };
+        let stop = |x: f64| least.is_some_and(|l| x >= l) || above(x);
+        let found = if free.finite_residuals(shape, &c, sigma) {
+            free.chi2(shape, tau_on, &c, sigma, stop)
+        } else {
+            free.chi2(shape, tau_on, &c, sigma, |_| false)
+        };
+        match found {
+            Chi2::Done(x) => {
+                if least.is_none_or(|l| x < l) {
+                    least = Some(x);
+                }
+            }
+            Chi2::Stopped => cut = true,
+            Chi2::NotFinite => {}
+        }
+    }
+    match least {
+        Some(x) => Least::Found(x),
+        None if cut => Least::Above,
+        None => Least::NoFit,
     }
 }
 
@@ -767,7 +1018,7 @@ fn restraint_exhaustive(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64
         omega0,
         sigma,
     };
-    grid.best((0..OMEGAS).flat_map(|i| (0..ZETAS).map(move |j| (i, j))))
+    grid.best_full((0..OMEGAS).flat_map(|i| (0..ZETAS).map(move |j| (i, j))))
 }
 
 /// A peak of a one-sided log read with the contact model ([`contact_peaks`]).
@@ -978,6 +1229,124 @@ mod tests {
             }
         }
         assert_eq!(checked, 2);
+    }
+
+    /// [`powi_small`] is `f64::powi` to the bit for the contact columns'
+    /// powers (0 … 4) of every s the fits meet (−1 … 300, 0.5 ms steps over
+    /// 10 ms) and of wide random ones.
+    #[test]
+    fn powi_small_is_powi() {
+        let mut rng = crate::synth::Rng::new(7);
+        let grid = (-200..=60_000).map(|i| i as f64 * 0.005);
+        let wide = (0..20_000).map(|_| rng.normal() * 10f64.powf(8.0 * rng.normal()));
+        let special = [0.0, -0.0, 1.0, -1.0, f64::MIN_POSITIVE, 1e77, -1e77, f64::INFINITY, f64::NAN];
+        for s in grid.chain(wide).chain(special) {
+            for n in 0..=5 {
+                let (a, b) = (powi_small(s, n), s.powi(n));
+                assert!(a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()), "{s}^{n}: {a} vs {b}");
+            }
+        }
+    }
+
+    /// A one-sided log of the compliant generator (the first seed from 1000
+    /// at 100 Hz) and its inward half-cycles' windows.
+    fn one_sided_windows() -> (Vec<Window>, f64, f64) {
+        use crate::synth::{draw, Family};
+        let s = (1000..1100)
+            .map(|seed| draw(seed, Family::Compliant))
+            .find(|s| s.spec.one_sided() && s.spec.fs_hz <= 100.0)
+            .expect("a one-sided draw");
+        let halves: Vec<(f64, f64)> = (1..s.crossings.len().min(12))
+            .filter(|k| k % 2 == 1)
+            .map(|k| (s.crossings[k - 1], s.crossings[k]))
+            .collect();
+        let (windows, omega0) = restraint_windows(&s.t, &s.x_mm, &halves, CONTACT_POST_S).expect("windows");
+        (windows, omega0, s.spec.sigma_mm.max(1e-3))
+    }
+
+    /// The bounded score of a pair is its full score to the bit wherever that
+    /// is within the bound, and None only where it exceeds it, for every pair
+    /// of the grid, both strides and bounds from below the least score to
+    /// above the largest (a window's least χ², [`least_chi2`], likewise).
+    #[test]
+    fn bounded_scores_are_the_full_ones() {
+        let (windows, omega0, sigma) = one_sided_windows();
+        assert!(windows.len() >= 3, "{} windows", windows.len());
+        let grid = RestraintGrid {
+            windows: &windows,
+            omega0,
+            sigma,
+        };
+        let (mut pruned, mut scored) = (0, 0);
+        for stride in [COARSE_STRIDE, 1] {
+            let pairs: Vec<(usize, usize)> = (0..OMEGAS)
+                .step_by(if stride == 1 { 6 } else { 1 })
+                .flat_map(|i| (0..ZETAS).map(move |j| (i, j)))
+                .collect();
+            let full: Vec<f64> = pairs.iter().map(|&ij| grid.score_full(ij, stride)).collect();
+            let mut sorted = full.clone();
+            sorted.sort_by(f64::total_cmp);
+            let bounds = [
+                0.0,
+                sorted[0],
+                sorted[3],
+                sorted[sorted.len() / 2],
+                sorted[sorted.len() - 1],
+                f64::INFINITY,
+            ];
+            for (&ij, &f) in pairs.iter().zip(&full) {
+                for bound in bounds {
+                    match grid.score(ij, stride, bound) {
+                        Some(v) => {
+                            assert_eq!(v.to_bits(), f.to_bits(), "{ij:?} stride {stride} bound {bound}: {v} vs {f}");
+                            scored += 1;
+                        }
+                        None => {
+                            assert!(f > bound, "{ij:?} stride {stride}: {f} pruned by {bound}");
+                            pruned += 1;
+                        }
+                    }
+                }
+                let (lambda, omega) = grid.pair(ij);
+                let m = FreeMotion::Restraint { lambda, omega };
+                for (tau, y) in &windows {
+                    let all = contact_fits_every(tau, y, m, ContactShape::Jump, sigma, stride);
+                    let least = all.iter().map(|f| f.chi2).min_by(f64::total_cmp);
+                    match (least_chi2(tau, y, m, ContactShape::Jump, sigma, stride, |_| false), least) {
+                        (Least::Found(a), Some(b)) => assert_eq!(a.to_bits(), b.to_bits(), "{ij:?}"),
+                        (Least::NoFit, None) => {}
+                        (got, want) => panic!("{ij:?}: {got:?} vs {want:?}"),
+                    }
+                }
+            }
+        }
+        // Both branches were taken.
+        assert!(pruned > 100 && scored > 100, "{pruned} pruned, {scored} scored");
+    }
+
+    /// The search with the bounds finds the pair the same search finds with
+    /// every pair scored in full, on the compliant generator's one-sided log.
+    #[test]
+    fn pruned_restraint_search_is_the_full_one() {
+        let (windows, omega0, sigma) = one_sided_windows();
+        let grid = RestraintGrid {
+            windows: &windows,
+            omega0,
+            sigma,
+        };
+        let every: Vec<(f64, (usize, usize))> = (0..OMEGAS)
+            .flat_map(|i| (0..ZETAS).map(move |j| (i, j)))
+            .map(|ij| (grid.score_full(ij, COARSE_STRIDE), ij))
+            .collect();
+        let coarse = grid.coarse();
+        assert!(coarse.len() < every.len() / 2, "{} of {} pairs scored", coarse.len(), every.len());
+        // Those scored are scored to the bit; the best four and their
+        // neighbours are the same, and so is the pair found.
+        assert!(coarse.iter().all(|c| every.iter().any(|e| e.1 == c.1 && e.0.to_bits() == c.0.to_bits())));
+        assert_eq!(near_best(coarse.clone()), near_best(every.clone()));
+        let full = grid.best_full(near_best(every));
+        assert_eq!(grid.best(near_best(coarse)), full);
+        assert!(full.is_some());
     }
 
     /// The contact fits summed over the samples after the onset (the free

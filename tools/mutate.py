@@ -373,7 +373,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--bin", type=Path, default=BIN, help="the binary to run (default target/release/rocklab)")
     a = ap.parse_args()
-    BIN = a.bin
+    BIN = a.bin.resolve()  # the cases run with their sandbox as the working folder
     if not BIN.exists():
         sys.exit(f"{BIN} not found: cargo build --release")
     counts = {"cases": 0, "exit0": 0, "exit2": 0, "other_exit": 0, "crash": 0, "hang": 0, "nonfinite": 0, "escape": 0,

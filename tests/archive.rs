@@ -115,9 +115,30 @@ fn add_twice_query_and_values_equal_summary() {
     assert!(page.contains("<svg") && page.contains("one-sided-demo") && page.contains("two-sided-demo"));
     // …and every impact's r against its amplitude (two panels, one per side).
     assert!(
-        page.contains(&format!("every archived impact ({} of tests with status ok)", listed.len())),
+        page.contains(&format!("every archived impact ({} impacts of the tests with status ok)", listed.len())),
         "impact figure missing"
     );
+    // Session 13: the campaigns' table averaged every test with status ok, 50_1
+    // (exclude_from_mean) too, so its mean r⁻ of one-sided-demo (0.591) was not
+    // the campaign's own (Table 1: 0.593). It is now the campaign's mean.
+    for doc in &docs {
+        let (c, m) = (doc["campaign"].as_str().unwrap(), &doc["mean"]);
+        let n = doc["mean_included"].as_array().unwrap().len();
+        let at = page.find(&format!(">{c}</td>")).unwrap_or_else(|| panic!("no row of {c}"));
+        let cells: Vec<&str> = page[at..]
+            .split("</tr>")
+            .next()
+            .unwrap()
+            .split("</td>")
+            .filter_map(|c| c.rsplit('>').next())
+            .collect();
+        let want = [
+            n.to_string(),
+            format!("{:.3}", m["r_plus"].as_f64().unwrap()),
+            format!("{:.3}", m["r_minus"].as_f64().unwrap()),
+        ];
+        assert_eq!(&cells[4..7], &want.iter().map(String::as_str).collect::<Vec<_>>()[..], "{c}: {cells:?}");
+    }
     assert_eq!(page.matches("r against amplitude").count(), 2);
     // A bad query is an error, not a crash.
     let e = archive::query(&arc, "SELECT nope FROM tests").unwrap_err();

@@ -20,6 +20,8 @@ struct Point {
     slenderness: f64,
     r_plus: (f64, Option<f64>),
     r_minus: (f64, Option<f64>),
+    /// In its campaign's means (not `exclude_from_mean`).
+    in_mean: bool,
 }
 
 fn text(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<String>>> {
@@ -40,6 +42,7 @@ fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
         numbers(df, "r_minus")?,
         numbers(df, "r_minus_u")?,
     );
+    let excluded: Vec<Option<bool>> = df.column("exclude_from_mean")?.bool()?.iter().collect();
     let mut out = Vec::new();
     for i in 0..df.height() {
         if status[i].as_deref() != Some("ok") {
@@ -52,6 +55,7 @@ fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
                 slenderness: s,
                 r_plus: (p, rpu[i]),
                 r_minus: (m, rmu[i]),
+                in_mean: excluded[i] != Some(true),
             });
         }
     }
@@ -167,7 +171,7 @@ pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveE
         page.figure(
             &fig.svg,
             &format!(
-                "r = e/e_H of every archived impact ({} of tests with status ok) against the amplitude of the half-cycle it ends, by campaign: the data a restitution law r(a) is fitted to (docs/restitution-law.md).",
+                "r = e/e_H of every archived impact ({} impacts of the tests with status ok) against the amplitude of the half-cycle it ends, by campaign: the data a restitution law r(a) is fitted to (docs/restitution-law.md).",
                 ipts.len()
             ),
         );
@@ -176,22 +180,32 @@ pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveE
     for p in &pts {
         by.entry((p.campaign.clone(), p.rocking.clone())).or_default().push(p);
     }
-    let mean = |v: &[&Point], f: fn(&Point) -> f64| v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64;
+    // The campaign's means: its tests with status ok that the manifest does not
+    // leave out (`exclude_from_mean`), as its Table 1 has them.
+    let mean = |v: &[&&Point], f: fn(&Point) -> f64| (!v.is_empty()).then(|| format!("{:.3}", v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64));
     let rows: Vec<Vec<String>> = by
         .iter()
         .map(|((c, r), v)| {
+            let inc: Vec<&&Point> = v.iter().filter(|p| p.in_mean).collect();
+            let none = || "— (every test left out)".to_string();
             vec![
                 c.clone(),
                 r.clone(),
                 format!("{:.2}", v[0].slenderness),
                 v.len().to_string(),
-                format!("{:.3}", mean(v, |p| p.r_plus.0)),
-                format!("{:.3}", mean(v, |p| p.r_minus.0)),
+                inc.len().to_string(),
+                mean(&inc, |p| p.r_plus.0).unwrap_or_else(none),
+                mean(&inc, |p| p.r_minus.0).unwrap_or_else(none),
             ]
         })
         .collect();
     page.h2("Campaigns");
-    page.table("meta", &["campaign", "rocking", "h/t", "tests ok", "mean r⁺", "mean r⁻"], &rows);
+    page.p("Mean r⁺ and r⁻ of each campaign's tests with status ok that its manifest keeps in the means (not exclude_from_mean): the means of its Table 1.");
+    page.table(
+        "meta",
+        &["campaign", "rocking", "h/t", "tests ok", "in the mean", "mean r⁺", "mean r⁻"],
+        &rows,
+    );
     Ok(page.finish())
 }
 

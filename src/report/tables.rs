@@ -212,7 +212,7 @@ fn build(v: &CampaignView, name: &'static str, caption: String, cols: Cols) -> T
 }
 
 fn mean_label(means: &CampaignMeans) -> String {
-    if let [only] = means.included.as_slice() {
+    if let (None, [only]) = (&means.means_u, means.included.as_slice()) {
         // One test: the "mean" is its values, and there is no spread between
         // tests to give it a ± (the row would read as a bare, exact-looking 82%).
         format!("mean = {only} alone (one test: no spread between tests, so no ±)")
@@ -322,7 +322,7 @@ mod tests {
         assert_eq!(mean_label(&m), "mean = F1_180_1 alone (one test: no spread between tests, so no ±)");
         let two = CampaignMeans {
             included: vec!["a".into(), "b".into()],
-            ..m
+            ..m.clone()
         };
         assert_eq!(mean_label(&two), "mean (without F1_190_1)");
     }

@@ -19,9 +19,11 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>, InputError> {
     })
 }
 
-/// The text of a TOML input.
+/// The text of a TOML input. Text that is not UTF-8 (a manifest saved as
+/// Latin-1 or Windows-1252 by an editor, with an `é` or a `°` in a comment) is
+/// refused at the line and column of its first such byte, saying so.
 pub fn read_text(path: &Path, kind: FileKind) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|e| {
+    let bytes = std::fs::read(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::NotFound {
             FileError::NotFound {
                 file: path.to_path_buf(),
@@ -33,6 +35,21 @@ pub fn read_text(path: &Path, kind: FileKind) -> Result<String, FileError> {
                 kind,
                 source: e,
             }
+        }
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        // The valid prefix is text: locate the byte in it.
+        let (line, column) = line_column(std::str::from_utf8(&bytes[..at]).unwrap_or_default(), at);
+        FileError::Invalid {
+            file: path.to_path_buf(),
+            line: Some(line),
+            column: Some(column),
+            message: format!(
+                "byte 0x{:02X} is not UTF-8 text: save the {kind} as UTF-8 (an editor's Latin-1 or Windows-1252 é, ° or ± is not)",
+                bytes[at]
+            ),
         }
     })
 }
@@ -67,6 +84,24 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // Session 13: a manifest with a Latin-1 'é' in a comment was refused as
+    // "stream did not contain valid UTF-8", without a line.
+    #[test]
+    fn text_that_is_not_utf8_is_located() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("campaign.toml");
+        std::fs::write(&p, b"# ok\n# Prova di laboratorio n\xb0 1, parete \xe9\n[campaign]\n").unwrap();
+        let e = read_text(&p, FileKind::Manifest).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "campaign.toml:2:25: byte 0xB0 is not UTF-8 text: save the manifest as UTF-8 (an editor's Latin-1 or Windows-1252 é, ° or ± is not)"
+            ),
+            "{e}"
+        );
+        std::fs::write(&p, "# n° 1 é ±\n[campaign]\n").unwrap();
+        assert_eq!(read_text(&p, FileKind::Manifest).unwrap(), "# n° 1 é ±\n[campaign]\n");
+    }
 
     #[test]
     fn a_parse_error_is_located() {

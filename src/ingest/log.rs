@@ -252,16 +252,7 @@ impl LogReader {
         }
         // The csv reader does not count skipped '#' lines in the header's position.
         let header_line = header_line_number(bytes);
-        // A header that is not UTF-8 is read as Latin-1 (each byte its character;
-        // Windows-1252 agrees on µ, °, ±, é): a logger that writes 'disp_µm' in
-        // Latin-1 matches the manifest's "disp_µm" instead of 'disp_\u{fffd}m'.
-        let names: Vec<String> = rec
-            .iter()
-            .map(|f| match std::str::from_utf8(f) {
-                Ok(t) => t.trim().to_string(),
-                Err(_) => f.iter().map(|&b| char::from(b)).collect::<String>().trim().to_string(),
-            })
-            .collect();
+        let names: Vec<String> = rec.iter().map(|f| header_name(f).trim().to_string()).collect();
         let find = |name: &str, what: &str| {
             names.iter().position(|n| n == name).ok_or_else(|| InputError::Line {
                 file: file.clone(),
@@ -517,6 +508,17 @@ fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, S
         return Err(format!("'{}' is not a finite number: expected a measured value", shown()));
     }
     Ok(v)
+}
+
+/// A header field as text: UTF-8, else Latin-1 (each byte its character;
+/// Windows-1252 agrees on µ, °, ±, é), so that a logger writing 'disp_µm' in
+/// Latin-1 matches a manifest's "disp_µm" instead of reading 'disp_\u{fffd}m'.
+/// `init` names the columns it drafts by the same rule.
+pub(crate) fn header_name(field: &[u8]) -> String {
+    match std::str::from_utf8(field) {
+        Ok(t) => t.to_string(),
+        Err(_) => field.iter().map(|&b| char::from(b)).collect(),
+    }
 }
 
 #[cfg(test)]

@@ -455,3 +455,28 @@ fn an_out_that_is_a_file_is_refused_before_any_work() {
     }
     assert_eq!(std::fs::read(&file).unwrap(), b"keep");
 }
+
+// Session 13: `calibrate --impacts 0` (or 1) reduced the campaign and then left
+// every test out as having "fewer than 0 impacts". It is refused at once.
+#[test]
+fn calibrate_refuses_an_impact_count_the_fit_cannot_use() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("out");
+    let manifest = fixtures().join("campaigns/one-sided-demo/campaign.toml");
+    for n in ["0", "1", "1001"] {
+        let (code, stderr) = run(&[
+            "calibrate".as_ref(),
+            manifest.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--impacts".as_ref(),
+            n.as_ref(),
+        ]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(
+            stderr.contains(&format!("--impacts = {n}: expected a value from 2 to 1000 impacts")),
+            "{stderr}"
+        );
+        assert!(!out.exists());
+    }
+}

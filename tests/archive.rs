@@ -137,7 +137,7 @@ fn add_twice_query_and_values_equal_summary() {
             format!("{:.3}", m["r_plus"].as_f64().unwrap()),
             format!("{:.3}", m["r_minus"].as_f64().unwrap()),
         ];
-        assert_eq!(&cells[4..7], &want.iter().map(String::as_str).collect::<Vec<_>>()[..], "{c}: {cells:?}");
+        assert_eq!(&cells[5..8], &want.iter().map(String::as_str).collect::<Vec<_>>()[..], "{c}: {cells:?}");
     }
     assert_eq!(page.matches("r against amplitude").count(), 2);
     // A bad query is an error, not a crash.
@@ -220,6 +220,36 @@ fn impacts_carry_their_tests_status_also_in_older_archives() {
     let (_, after) = archive::load(&arc).unwrap();
     assert_eq!(after.height(), 14);
     assert_eq!(strs(&after, "status").iter().filter(|s| s.starts_with("suspect")).count(), 4);
+}
+
+/// Session 13: a campaign whose tests are all suspect (the engine campaign
+/// fresh-one-s8) was archived but missing from the page's table of campaigns.
+#[test]
+fn every_archived_campaign_is_in_the_page_even_with_no_test_ok() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut doc = spec_summary("aa", 2, 2);
+    for t in 0..2 {
+        doc["tests"][t]["status"] = json!("suspect: the fit misses the log");
+    }
+    let arc = tmp.path().join("arc");
+    archive::add(&arc, &[write_summary(&tmp.path().join("r"), &doc)]).unwrap();
+    let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
+    let at = page.find(">c-aa</td>").expect("the campaign has no row");
+    let row = page[at..].split("</tr>").next().unwrap();
+    let cells: Vec<&str> = row.split("</td>").filter_map(|c| c.rsplit('>').next()).collect();
+    assert_eq!(
+        cells[..8],
+        [
+            "c-aa",
+            "one-sided",
+            "7.50",
+            "2",
+            "0",
+            "0",
+            "— (no test in the means)",
+            "— (no test in the means)"
+        ]
+    );
 }
 
 /// (tests rows, impacts rows, the shas in each) of an archive as a reader finds it.

@@ -176,22 +176,37 @@ pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveE
             ),
         );
     }
-    let mut by: BTreeMap<(String, String), Vec<&Point>> = BTreeMap::new();
+    // Every archived campaign has a row, also one whose tests are all suspect
+    // (it was missing from the table, as if not archived).
+    let page_err = |e: PolarsError| ArchiveError::Page(e.to_string());
+    let (campaign, rocking) = (text(tests, "campaign").map_err(page_err)?, text(tests, "rocking").map_err(page_err)?);
+    let slenderness = numbers(tests, "slenderness").map_err(page_err)?;
+    type Group<'a> = (usize, Option<f64>, Vec<&'a Point>);
+    let mut by: BTreeMap<(String, String), Group> = BTreeMap::new();
+    for i in 0..tests.height() {
+        let key = (campaign[i].clone().unwrap_or_default(), rocking[i].clone().unwrap_or_default());
+        let g = by.entry(key).or_insert((0, None, Vec::new()));
+        g.0 += 1;
+        g.1 = g.1.or(slenderness[i]);
+    }
     for p in &pts {
-        by.entry((p.campaign.clone(), p.rocking.clone())).or_default().push(p);
+        if let Some(g) = by.get_mut(&(p.campaign.clone(), p.rocking.clone())) {
+            g.2.push(p);
+        }
     }
     // The campaign's means: its tests with status ok that the manifest does not
     // leave out (`exclude_from_mean`), as its Table 1 has them.
     let mean = |v: &[&&Point], f: fn(&Point) -> f64| (!v.is_empty()).then(|| format!("{:.3}", v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64));
     let rows: Vec<Vec<String>> = by
         .iter()
-        .map(|((c, r), v)| {
+        .map(|((c, r), (n, sl, v))| {
             let inc: Vec<&&Point> = v.iter().filter(|p| p.in_mean).collect();
-            let none = || "— (every test left out)".to_string();
+            let none = || "— (no test in the means)".to_string();
             vec![
                 c.clone(),
                 r.clone(),
-                format!("{:.2}", v[0].slenderness),
+                sl.map_or_else(|| "—".to_string(), |x| format!("{x:.2}")),
+                n.to_string(),
                 v.len().to_string(),
                 inc.len().to_string(),
                 mean(&inc, |p| p.r_plus.0).unwrap_or_else(none),
@@ -203,7 +218,7 @@ pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveE
     page.p("Mean r⁺ and r⁻ of each campaign's tests with status ok that its manifest keeps in the means (not exclude_from_mean): the means of its Table 1.");
     page.table(
         "meta",
-        &["campaign", "rocking", "h/t", "tests ok", "in the mean", "mean r⁺", "mean r⁻"],
+        &["campaign", "rocking", "h/t", "tests", "tests ok", "in the mean", "mean r⁺", "mean r⁻"],
         &rows,
     );
     Ok(page.finish())

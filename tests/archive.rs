@@ -252,6 +252,47 @@ fn every_archived_campaign_is_in_the_page_even_with_no_test_ok() {
     );
 }
 
+/// Session 13: a campaign reduced again after a fix to its manifest (another
+/// SHA-256) was added beside its first reduction without a word, and the page
+/// merged both into one row (10 tests, one mean). The add now says so, and the
+/// page gives each reduction its row, named with its manifest.
+#[test]
+fn a_campaign_from_a_corrected_manifest_is_said_and_shown_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let arc = tmp.path().join("arc");
+    let first = spec_summary("aa", 2, 2);
+    let mut second = spec_summary("bb", 3, 2);
+    second["campaign"] = first["campaign"].clone();
+    archive::add(&arc, &[write_summary(&tmp.path().join("r1"), &first)]).unwrap();
+    let added = archive::add(&arc, &[write_summary(&tmp.path().join("r2"), &second)]).unwrap();
+    assert!(
+        added
+            .notes
+            .iter()
+            .any(|n| n.starts_with("c-aa is also in the archive from another manifest (aa…, 2 tests): both are kept")),
+        "{:?}",
+        added.notes
+    );
+    let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
+    for (sha, n) in [("aa", "2"), ("bb", "3")] {
+        let at = page
+            .find(&format!(">c-aa (manifest {sha}…)</td>"))
+            .unwrap_or_else(|| panic!("no row for {sha}"));
+        let cells: Vec<&str> = page[at..]
+            .split("</tr>")
+            .next()
+            .unwrap()
+            .split("</td>")
+            .filter_map(|c| c.rsplit('>').next())
+            .collect();
+        assert_eq!(cells[3], n, "{cells:?}");
+    }
+    // A re-add of the same manifest replaces, and is not such a case.
+    let again = archive::add(&arc, &[write_summary(&tmp.path().join("r3"), &second)]).unwrap();
+    assert_eq!(again.reductions[0].4, 3);
+    assert!(again.notes.iter().any(|n| n.contains("(aa…, 2 tests)")), "{:?}", again.notes);
+}
+
 /// (tests rows, impacts rows, the shas in each) of an archive as a reader finds it.
 fn state(arc: &Path) -> (usize, usize, BTreeSet<String>, BTreeSet<String>) {
     let (t, i) = archive::load(arc).unwrap();

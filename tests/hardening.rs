@@ -480,3 +480,35 @@ fn calibrate_refuses_an_impact_count_the_fit_cannot_use() {
         assert!(!out.exists());
     }
 }
+
+// Session 13: a log in mm declared as m (152 m at a sensor 2.33 m above the
+// hinge) was reduced into "impacts 2.5 ms apart" and r⁺ = 328 ± 82966 %, marked
+// suspect for reasons that never named the unit. Each test is now an error that
+// says what cannot be and what to check.
+#[test]
+fn a_displacement_beyond_the_lever_arm_names_the_unit() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = root.path();
+    demo_copy_with_log_named(camp, "150_1.csv");
+    let manifest = std::fs::read_to_string(camp.join("campaign.toml")).unwrap();
+    let wrong = manifest.replace("unit = \"mm\", height_m", "unit = \"m\", height_m");
+    assert_ne!(wrong, manifest);
+    std::fs::write(camp.join("campaign.toml"), wrong).unwrap();
+    let out = root.path().join("out");
+    let (code, stderr) = run(&[
+        "reduce".as_ref(),
+        camp.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--no-plots".as_ref(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("150_1.csv: the displacement spans 162380 mm")
+            && stderr.contains("more than the sensor's lever arm about the hinge (2330 mm)"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("[channels].displacement.unit"), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["tests"].as_array().unwrap().iter().all(|t| t["status"] == "error"), "{summary}");
+}

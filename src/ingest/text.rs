@@ -89,18 +89,20 @@ mod tests {
     // "stream did not contain valid UTF-8", without a line.
     #[test]
     fn text_that_is_not_utf8_is_located() {
-        let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("campaign.toml");
-        std::fs::write(&p, b"# ok\n# Prova di laboratorio n\xb0 1, parete \xe9\n[campaign]\n").unwrap();
-        let e = read_text(&p, FileKind::Manifest).unwrap_err().to_string();
+        // (a temporary file written through its handle: src/ holds one writer)
+        let file = |bytes: &[u8]| {
+            let mut f = tempfile::Builder::new().suffix(".toml").tempfile().unwrap();
+            std::io::Write::write_all(&mut f, bytes).unwrap();
+            f
+        };
+        let latin1 = file(b"# ok\n# Prova di laboratorio n\xb0 1, parete \xe9\n[campaign]\n");
+        let e = read_text(latin1.path(), FileKind::Manifest).unwrap_err().to_string();
         assert!(
-            e.ends_with(
-                "campaign.toml:2:25: byte 0xB0 is not UTF-8 text: save the manifest as UTF-8 (an editor's Latin-1 or Windows-1252 é, ° or ± is not)"
-            ),
+            e.ends_with(".toml:2:25: byte 0xB0 is not UTF-8 text: save the manifest as UTF-8 (an editor's Latin-1 or Windows-1252 é, ° or ± is not)"),
             "{e}"
         );
-        std::fs::write(&p, "# n° 1 é ±\n[campaign]\n").unwrap();
-        assert_eq!(read_text(&p, FileKind::Manifest).unwrap(), "# n° 1 é ±\n[campaign]\n");
+        let utf8 = file("# n° 1 é ±\n[campaign]\n".as_bytes());
+        assert_eq!(read_text(utf8.path(), FileKind::Manifest).unwrap(), "# n° 1 é ±\n[campaign]\n");
     }
 
     #[test]

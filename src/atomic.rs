@@ -4,7 +4,7 @@
 //! the sanitised names of the report's `file_stem`).
 
 use std::io::Write;
-use std::path::{Component, Path};
+use std::path::{Component, Path, PathBuf};
 
 /// Why `rel` cannot be written under an output folder, if it cannot: it must be
 /// relative, made of plain names only (no `..`, `.`, root or prefix), none
@@ -59,6 +59,101 @@ pub fn check_no_link(root: &Path, rel: &Path) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Write a set of files under `root` as one step, as far as a file system
+/// allows: every file is first staged beside its place (a temporary sibling,
+/// written and synced), and only once all are staged are they renamed into place,
+/// one after the other (no I/O wait between the renames). So a failure while
+/// staging — a full disk, a file where a folder should be — or a run killed
+/// before its renames replaces nothing: the temporaries are removed (a killed
+/// run's by the next run that writes the same names), and so are the folders
+/// this call created, when left empty. Each path is checked first
+/// ([`check_relative`], [`check_no_link`]). On failure: the path and the error.
+pub fn write_set_under(root: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, std::io::Error)> {
+    let refuse = |rel: &Path, why| (root.join(rel), std::io::Error::new(std::io::ErrorKind::InvalidInput, why));
+    for (rel, _) in files {
+        check_relative(rel).map_err(|why| refuse(rel, why))?;
+        check_no_link(root, rel).map_err(|why| refuse(rel, why))?;
+    }
+    let (mut created, mut staged) = (Vec::new(), Vec::new());
+    let result = (|| {
+        for (rel, bytes) in files {
+            let path = root.join(rel);
+            let dir = path.parent().unwrap_or(root);
+            create_folders(dir, &mut created)?;
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+            remove_stale_temporaries(dir, &name);
+            let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+            staged.push((tmp.clone(), path.clone()));
+            write_synced(&tmp, bytes).map_err(|e| (path.clone(), e))?;
+        }
+        for (tmp, path) in &staged {
+            std::fs::rename(tmp, path).map_err(|e| (path.clone(), e))?;
+        }
+        Ok(())
+    })();
+    if result.is_err() {
+        for (tmp, _) in &staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+        for dir in created.iter().rev() {
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+    result
+}
+
+/// Create `dir` and the folders above it that are missing, noting each one
+/// created (top first); a file where a folder is needed is named as such.
+fn create_folders(dir: &Path, created: &mut Vec<PathBuf>) -> Result<(), (PathBuf, std::io::Error)> {
+    let mut missing = Vec::new();
+    for at in dir.ancestors().filter(|a| !a.as_os_str().is_empty()) {
+        match std::fs::metadata(at) {
+            Ok(m) if m.is_dir() => break,
+            Ok(_) => {
+                let e = std::io::Error::new(std::io::ErrorKind::AlreadyExists, "a file is there, not a folder");
+                return Err((at.to_path_buf(), e));
+            }
+            Err(_) => missing.push(at.to_path_buf()),
+        }
+    }
+    for at in missing.into_iter().rev() {
+        match std::fs::create_dir(&at) {
+            Ok(()) => created.push(at),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && at.is_dir() => {}
+            Err(e) => return Err((at, e)),
+        }
+    }
+    Ok(())
+}
+
+/// Remove the temporaries `.NAME.tmp-PID` in `dir` that a killed run left: those
+/// of a process that no longer runs (known from `/proc`; elsewhere none is
+/// removed, as a live run's may not be).
+fn remove_stale_temporaries(dir: &Path, name: &str) {
+    let prefix = format!(".{name}.tmp-");
+    let proc_fs = Path::new("/proc/self").exists();
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(pid) = file
+            .strip_prefix(&prefix)
+            .filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+        else {
+            continue;
+        };
+        if proc_fs && !Path::new("/proc").join(pid).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Write `bytes` to a new file at `path` and sync it to the disk.
+fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut f = std::fs::File::create(path)?;
+    f.write_all(bytes)?;
+    f.sync_all()
 }
 
 /// Write `bytes` to `path` atomically (temporary sibling, fsync, rename).

@@ -55,6 +55,9 @@ pub struct Study {
     pub rtol: f64,
     pub records: Vec<StudyRecord>,
     pub sets: Vec<CoefficientSet>,
+    /// The files the sets were read from (`calibration = FILE`, `law = FILE`),
+    /// resolved against the study's folder: inputs no output may replace.
+    pub coefficient_files: Vec<PathBuf>,
     /// e_H by Eq. 2 with the block's α (reported next to any given Housner value).
     pub e_housner_eq2: f64,
     /// The overturning limit as given (None: α, which a sample may vary).

@@ -88,6 +88,9 @@ pub const LOG_RATE_HZ: Range = Range::new(1.0, 1e6, "Hz");
 pub const MAX_SAMPLES: usize = 100_000;
 /// Points of an IDA (`--scales FROM:TO:N`).
 pub const MAX_SCALES: usize = 1000;
+/// Impacts in a calibration's fitted window (`calibrate --impacts`): the fit of
+/// e_in and e_out needs two; more than a test resolves leaves it out, saying so.
+pub const CALIBRATION_IMPACTS: Range = Range::new(2.0, 1000.0, "impacts");
 /// Overturning limit: 0 < θ ≤ π/2 rad.
 pub const ANGLE_RAD: Range = Range::new(1e-6, std::f64::consts::FRAC_PI_2, "rad");
 

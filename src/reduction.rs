@@ -55,6 +55,12 @@ pub enum ReduceError {
     /// Eqs. 3–6 need six peaks.
     #[error("too few peaks (n = {found} < 6)")]
     TooFewPeaks { found: usize },
+    /// A displacement no rotation about the hinge can give (session 13: a log in
+    /// mm read as m was reduced into "impacts 2.5 ms apart" and ratios of 300 %).
+    #[error(
+        "the displacement spans {span_mm:.0} mm, more than the sensor's lever arm about the hinge ({lever_mm:.0} mm): no rotation of the wall moves the sensor that far; is the displacement's unit right ([channels].displacement.unit: a log in mm read as m is 1000 times too large)?"
+    )]
+    BeyondLeverArm { span_mm: f64, lever_mm: f64 },
 }
 
 /// The physics the estimator starts from: the rocking kind, the sensor's lever arm
@@ -69,6 +75,16 @@ pub fn physics(rocking: Rocking, wall: &Wall, lever_arm_m: f64) -> Physics {
 
 /// Reduce one log: `log` holds time in s and displacement in mm, outward positive.
 pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOptions) -> Result<Reduced, ReduceError> {
+    let (lo, hi) = log
+        .disp_mm
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+    if hi - lo > phys.lever_arm_mm {
+        return Err(ReduceError::BeyondLeverArm {
+            span_mm: hi - lo,
+            lever_mm: phys.lever_arm_mm,
+        });
+    }
     let mut analysis = analyse(&log.time_s, &log.disp_mm, phys, options)?;
     let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let c = coefficients(&v, e_housner).ok_or(ReduceError::TooFewPeaks { found: v.len() })?;

@@ -115,9 +115,30 @@ fn add_twice_query_and_values_equal_summary() {
     assert!(page.contains("<svg") && page.contains("one-sided-demo") && page.contains("two-sided-demo"));
     // …and every impact's r against its amplitude (two panels, one per side).
     assert!(
-        page.contains(&format!("every archived impact ({} of tests with status ok)", listed.len())),
+        page.contains(&format!("every archived impact ({} impacts of the tests with status ok)", listed.len())),
         "impact figure missing"
     );
+    // Session 13: the campaigns' table averaged every test with status ok, 50_1
+    // (exclude_from_mean) too, so its mean r⁻ of one-sided-demo (0.591) was not
+    // the campaign's own (Table 1: 0.593). It is now the campaign's mean.
+    for doc in &docs {
+        let (c, m) = (doc["campaign"].as_str().unwrap(), &doc["mean"]);
+        let n = doc["mean_included"].as_array().unwrap().len();
+        let at = page.find(&format!(">{c}</td>")).unwrap_or_else(|| panic!("no row of {c}"));
+        let cells: Vec<&str> = page[at..]
+            .split("</tr>")
+            .next()
+            .unwrap()
+            .split("</td>")
+            .filter_map(|c| c.rsplit('>').next())
+            .collect();
+        let want = [
+            n.to_string(),
+            format!("{:.3}", m["r_plus"].as_f64().unwrap()),
+            format!("{:.3}", m["r_minus"].as_f64().unwrap()),
+        ];
+        assert_eq!(&cells[5..8], &want.iter().map(String::as_str).collect::<Vec<_>>()[..], "{c}: {cells:?}");
+    }
     assert_eq!(page.matches("r against amplitude").count(), 2);
     // A bad query is an error, not a crash.
     let e = archive::query(&arc, "SELECT nope FROM tests").unwrap_err();
@@ -199,6 +220,77 @@ fn impacts_carry_their_tests_status_also_in_older_archives() {
     let (_, after) = archive::load(&arc).unwrap();
     assert_eq!(after.height(), 14);
     assert_eq!(strs(&after, "status").iter().filter(|s| s.starts_with("suspect")).count(), 4);
+}
+
+/// Session 13: a campaign whose tests are all suspect (the engine campaign
+/// fresh-one-s8) was archived but missing from the page's table of campaigns.
+#[test]
+fn every_archived_campaign_is_in_the_page_even_with_no_test_ok() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut doc = spec_summary("aa", 2, 2);
+    for t in 0..2 {
+        doc["tests"][t]["status"] = json!("suspect: the fit misses the log");
+    }
+    let arc = tmp.path().join("arc");
+    archive::add(&arc, &[write_summary(&tmp.path().join("r"), &doc)]).unwrap();
+    let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
+    let at = page.find(">c-aa</td>").expect("the campaign has no row");
+    let row = page[at..].split("</tr>").next().unwrap();
+    let cells: Vec<&str> = row.split("</td>").filter_map(|c| c.rsplit('>').next()).collect();
+    assert_eq!(
+        cells[..8],
+        [
+            "c-aa",
+            "one-sided",
+            "7.50",
+            "2",
+            "0",
+            "0",
+            "— (no test in the means)",
+            "— (no test in the means)"
+        ]
+    );
+}
+
+/// Session 13: a campaign reduced again after a fix to its manifest (another
+/// SHA-256) was added beside its first reduction without a word, and the page
+/// merged both into one row (10 tests, one mean). The add now says so, and the
+/// page gives each reduction its row, named with its manifest.
+#[test]
+fn a_campaign_from_a_corrected_manifest_is_said_and_shown_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let arc = tmp.path().join("arc");
+    let first = spec_summary("aa", 2, 2);
+    let mut second = spec_summary("bb", 3, 2);
+    second["campaign"] = first["campaign"].clone();
+    archive::add(&arc, &[write_summary(&tmp.path().join("r1"), &first)]).unwrap();
+    let added = archive::add(&arc, &[write_summary(&tmp.path().join("r2"), &second)]).unwrap();
+    assert!(
+        added
+            .notes
+            .iter()
+            .any(|n| n.starts_with("c-aa is also in the archive from another manifest (aa…, 2 tests): both are kept")),
+        "{:?}",
+        added.notes
+    );
+    let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
+    for (sha, n) in [("aa", "2"), ("bb", "3")] {
+        let at = page
+            .find(&format!(">c-aa (manifest {sha}…)</td>"))
+            .unwrap_or_else(|| panic!("no row for {sha}"));
+        let cells: Vec<&str> = page[at..]
+            .split("</tr>")
+            .next()
+            .unwrap()
+            .split("</td>")
+            .filter_map(|c| c.rsplit('>').next())
+            .collect();
+        assert_eq!(cells[3], n, "{cells:?}");
+    }
+    // A re-add of the same manifest replaces, and is not such a case.
+    let again = archive::add(&arc, &[write_summary(&tmp.path().join("r3"), &second)]).unwrap();
+    assert_eq!(again.reductions[0].4, 3);
+    assert!(again.notes.iter().any(|n| n.contains("(aa…, 2 tests)")), "{:?}", again.notes);
 }
 
 /// (tests rows, impacts rows, the shas in each) of an archive as a reader finds it.

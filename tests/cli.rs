@@ -920,6 +920,14 @@ fn facade_law_set() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     std::fs::write(dir.path().join("bad.json"), "{\n  \"form\": \"speed-loss\",\n  \"parameters\": 3\n}\n").unwrap();
     std::fs::write(dir.path().join("none.json"), "{\"campaign\": \"x\"}").unwrap();
+    // Session 13: a reduction that fitted no law (fresh-one-default: too few inward
+    // impacts) was refused as "missing field `form`".
+    let why = "side in: 3 impacts with uncertainties; the law needs at least 4";
+    std::fs::write(
+        dir.path().join("nolaw.json"),
+        format!("{{\"campaign\": \"x\",\n \"restitution_law\": {{\"error\": \"{why}\"}}}}"),
+    )
+    .unwrap();
     for (set, expect) in [
         ("law = \"summary.json\"\ne_in = 0.5", "law = FILE takes no e"),
         ("law = \"summary.json\"\nspread = \"tests\"", "spread = \"tests\": a law set takes"),
@@ -928,6 +936,10 @@ fn facade_law_set() {
         ("law = \"missing.json\"", "not found"),
         ("law = \"bad.json\"", "bad.json:3"),
         ("law = \"none.json\"", "no restitution_law"),
+        (
+            "law = \"nolaw.json\"",
+            "nolaw.json:2:21: restitution_law: the reduction fitted no law to this campaign (side in: 3 impacts",
+        ),
     ] {
         let study = write_study(dir.path(), &with_set(set));
         let o = facade(&study, &dir.path().join("o3"), &[]);

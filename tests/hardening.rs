@@ -292,3 +292,223 @@ fn a_huge_test_id_is_cut_in_the_plots_without_a_hang() {
     assert_eq!(code, 0, "{stderr}");
     assert!(tree(&out).iter().any(|p| p.to_string_lossy().ends_with("_motion.png")));
 }
+
+/// A copy of the one-sided demo campaign in `dir`, its log `150_1.csv` renamed
+/// `log_name` (and the manifest pointing at it).
+fn demo_copy_with_log_named(dir: &Path, log_name: &str) {
+    let demo = fixtures().join("campaigns/one-sided-demo");
+    for e in std::fs::read_dir(&demo).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let to = if name == "150_1.csv" { log_name.to_string() } else { name.clone() };
+        std::fs::copy(e.path(), dir.join(to)).unwrap();
+    }
+    let manifest = std::fs::read_to_string(dir.join("campaign.toml")).unwrap();
+    let manifest = manifest.replace("file = \"150_1.csv\"", &format!("file = \"{log_name}\""));
+    assert!(manifest.contains(log_name));
+    std::fs::write(dir.join("campaign.toml"), manifest).unwrap();
+}
+
+/// Every file below `dir` with its bytes.
+fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    tree(dir).into_iter().map(|p| (p.clone(), std::fs::read(dir.join(&p)).unwrap())).collect()
+}
+
+// Session 13: `reduce C --out C` with a log named like an output (`table1.csv`)
+// replaced the lab's raw log by Table 1. An output that would replace an input
+// of the run is refused, and nothing is written.
+#[test]
+fn reduce_into_its_own_folder_never_replaces_an_input() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = root.path();
+    demo_copy_with_log_named(camp, "table1.csv");
+    let before = contents(camp);
+    let (code, stderr) = run(&[
+        "reduce".as_ref(),
+        camp.as_os_str(),
+        "--out".as_ref(),
+        camp.as_os_str(),
+        "--no-plots".as_ref(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("output table1.csv:") && stderr.contains("is an input of this run"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("nothing was written"), "{stderr}");
+    assert_eq!(contents(camp), before, "an input was changed or an output written");
+    // Without a clash the campaign's own folder is a valid --out, inputs untouched.
+    let root = tempfile::tempdir().unwrap();
+    let camp = root.path();
+    demo_copy_with_log_named(camp, "150_1.csv");
+    let before = contents(camp);
+    let (code, stderr) = run(&[
+        "reduce".as_ref(),
+        camp.as_os_str(),
+        "--out".as_ref(),
+        camp.as_os_str(),
+        "--no-plots".as_ref(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let after = contents(camp);
+    for (p, bytes) in &before {
+        assert_eq!(after.iter().find(|(q, _)| q == p).map(|(_, b)| b), Some(bytes), "{p:?} changed");
+    }
+    assert!(after.iter().any(|(p, _)| p == Path::new("table1.csv")));
+}
+
+// Session 13: a study whose law set reads `summary.json` from the folder given
+// as --out had that file replaced by the study's own summary.json; a block file
+// read by `simulate` likewise. Both are refused, the inputs left as they were.
+#[test]
+fn facade_and_simulate_never_replace_the_files_they_read() {
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path();
+    let mut text = study(&["r"], &[]);
+    text.push_str("[[coefficients]]\nname = \"law\"\nlaw = \"summary.json\"\nspread = \"none\"\n");
+    for (name, bytes) in study_files(text) {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    std::fs::copy(fixtures().join("facade/law.json"), dir.join("summary.json")).unwrap();
+    let before = contents(dir);
+    let (code, stderr) = run(&["facade".as_ref(), dir.join("study.toml").as_os_str(), "--out".as_ref(), dir.as_os_str()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("output summary.json:") && stderr.contains("is an input of this run"),
+        "{stderr}"
+    );
+    assert_eq!(contents(dir), before);
+
+    std::fs::copy(dir.join("block.toml"), dir.join("history.csv")).unwrap();
+    let before = contents(dir);
+    let (code, stderr) = run(&[
+        "simulate".as_ref(),
+        "--block".as_ref(),
+        dir.join("history.csv").as_os_str(),
+        "--record".as_ref(),
+        dir.join("pulse.AT2").as_os_str(),
+        "--e".as_ref(),
+        "0.9".as_ref(),
+        "--out".as_ref(),
+        dir.as_os_str(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("output history.csv:") && stderr.contains("is an input of this run"),
+        "{stderr}"
+    );
+    assert_eq!(contents(dir), before);
+}
+
+// Session 13: the writer wrote file after file, so a failure half-way (a full
+// disk; here a file where a folder must be) left part of a set behind, and a run
+// killed while writing left a hidden temporary. Now every file is staged first:
+// a failure while staging removes what was staged and the folders it made, and
+// a dead run's temporaries are removed by the next run writing those names.
+#[test]
+fn a_failure_while_writing_leaves_nothing_and_old_temporaries_are_cleared() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("plots"), "a file where a folder is needed").unwrap();
+    let mut files = Files::default();
+    files.add("summary.json", "{}");
+    files.add("sub/a.csv", "a\n1\n");
+    files.add("plots/p.svg", "<svg/>");
+    let e = write_files(&out, &files).unwrap_err().to_string();
+    assert!(e.contains("plots") && e.contains("a file is there, not a folder"), "{e}");
+    assert_eq!(
+        tree(root.path()),
+        BTreeSet::from([PathBuf::from("out/plots")]),
+        "part of the set was written"
+    );
+    assert!(!out.join("sub").exists(), "a folder made for the failed set was left");
+
+    // A temporary of a process that no longer runs (pid above any pid_max).
+    let stale = out.join(".summary.json.tmp-4999999999");
+    std::fs::write(&stale, "half").unwrap();
+    std::fs::remove_file(out.join("plots")).unwrap();
+    write_files(&out, &files).unwrap();
+    assert!(!stale.exists() || !Path::new("/proc/self").exists(), "the dead run's temporary was left");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), b"{}");
+}
+
+// Session 13: `--out` naming a file ran the whole reduction, then said
+// "File exists (os error 17)". It is refused at once, naming the file.
+#[test]
+fn an_out_that_is_a_file_is_refused_before_any_work() {
+    let root = tempfile::tempdir().unwrap();
+    let file = root.path().join("notes.txt");
+    std::fs::write(&file, "keep").unwrap();
+    let manifest = fixtures().join("campaigns/one-sided-demo/campaign.toml");
+    for out in [file.clone(), file.join("sub")] {
+        let o = Command::new(env!("CARGO_BIN_EXE_rocklab"))
+            .arg("reduce")
+            .arg(&manifest)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let (stdout, stderr) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("notes.txt is a file, not a folder"), "{stderr}");
+        assert!(!stdout.contains("campaign one-sided-demo"), "the campaign was reduced first: {stdout}");
+    }
+    assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+}
+
+// Session 13: `calibrate --impacts 0` (or 1) reduced the campaign and then left
+// every test out as having "fewer than 0 impacts". It is refused at once.
+#[test]
+fn calibrate_refuses_an_impact_count_the_fit_cannot_use() {
+    let root = tempfile::tempdir().unwrap();
+    let out = root.path().join("out");
+    let manifest = fixtures().join("campaigns/one-sided-demo/campaign.toml");
+    for n in ["0", "1", "1001"] {
+        let (code, stderr) = run(&[
+            "calibrate".as_ref(),
+            manifest.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "--impacts".as_ref(),
+            n.as_ref(),
+        ]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(
+            stderr.contains(&format!("--impacts = {n}: expected a value from 2 to 1000 impacts")),
+            "{stderr}"
+        );
+        assert!(!out.exists());
+    }
+}
+
+// Session 13: a log in mm declared as m (152 m at a sensor 2.33 m above the
+// hinge) was reduced into "impacts 2.5 ms apart" and r⁺ = 328 ± 82966 %, marked
+// suspect for reasons that never named the unit. Each test is now an error that
+// says what cannot be and what to check.
+#[test]
+fn a_displacement_beyond_the_lever_arm_names_the_unit() {
+    let root = tempfile::tempdir().unwrap();
+    let camp = root.path();
+    demo_copy_with_log_named(camp, "150_1.csv");
+    let manifest = std::fs::read_to_string(camp.join("campaign.toml")).unwrap();
+    let wrong = manifest.replace("unit = \"mm\", height_m", "unit = \"m\", height_m");
+    assert_ne!(wrong, manifest);
+    std::fs::write(camp.join("campaign.toml"), wrong).unwrap();
+    let out = root.path().join("out");
+    let (code, stderr) = run(&[
+        "reduce".as_ref(),
+        camp.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--no-plots".as_ref(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("150_1.csv: the displacement spans 162380 mm")
+            && stderr.contains("more than the sensor's lever arm about the hinge (2330 mm)"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("[channels].displacement.unit"), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["tests"].as_array().unwrap().iter().all(|t| t["status"] == "error"), "{summary}");
+}

@@ -241,7 +241,7 @@ fn only_write_files_writes_and_rendering_stays_in_report() {
         .iter()
         .filter(|(p, _)| !p.ends_with("atomic.rs"))
         .flat_map(|(p, text)| {
-            ["write_atomic(", "write_under(", "fs::write(", "File::create("]
+            ["write_atomic(", "write_under(", "write_set_under(", "fs::write(", "File::create("]
                 .iter()
                 .filter(|w| text.lines().any(|l| l.contains(*w) && !l.trim_start().starts_with("//")))
                 .map(move |w| format!("{} calls {w}", p.display()))

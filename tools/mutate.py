@@ -6,7 +6,8 @@ manifests (`reduce`), the loggers' binary formats (TDMS, MAT v5 and v7.3,
 Parquet, Excel: byte flips, truncation, zeroed blocks, `reduce`), `[acquisition]`
 tables with hostile values (`reduce`), campaigns to `calibrate`, reductions'
 summary.json for `archive add`, ground-motion records and block files
-(`simulate`), study files (`facade`) — of the kinds that found the defects of issue 22: scaled
+(`simulate`), study files (`facade`), restitution law files (`facade`, session 13)
+and logs for `init` (session 13) — of the kinds that found the defects of issue 22: scaled
 columns, huge/tiny/NaN/inf values, path-like names, NUL, truncation, long cells,
 wrong types. Runs the release binary on each in a fresh sandbox folder with a
 20 s limit and a 2 GiB address-space cap (`ulimit -v`), and checks:
@@ -130,10 +131,20 @@ def scale_column(rng, b):
 def case_inputs(rng, sandbox):
     """Write one case's inputs into `sandbox/work` and return (kind, description, argv)."""
     work = sandbox / "work"
-    kind = rng.choice(["log", "manifest", "record", "block", "study", "format", "acquisition", "calibrate", "archive"])
+    kind = rng.choice(["log", "manifest", "record", "block", "study", "format", "acquisition", "calibrate", "archive",
+                       "law", "init"])
     out = work / "out" / "o"
     if kind in ("format", "acquisition", "calibrate", "archive"):
         return newer_case(rng, work, out, kind)
+    if kind == "init":
+        # `init` writes DIR/campaign.toml beside the logs: its --out is the folder.
+        camp = rng.choice(["one-sided-demo", "two-sided-demo", "mujoco-public-one-sided", "daq-public-bessel-1"])
+        shutil.copytree(FIX / "campaigns" / camp, out)
+        for extra in ("campaign.toml", "truth.json"):
+            (out / extra).unlink(missing_ok=True)
+        target = rng.choice(sorted(out.glob("*.csv")))
+        desc = mutate_file(rng, target, "text")
+        return kind, f"{camp}/{target.name} {desc}", ["init", str(out)]
     if kind in ("log", "manifest"):
         camp = rng.choice(["one-sided-demo", "two-sided-demo"])
         shutil.copytree(FIX / "campaigns" / camp, work / "c")
@@ -148,6 +159,17 @@ def case_inputs(rng, sandbox):
     shutil.copytree(FIX / "ground-motions", work / "ground-motions")
     study = (work / "f" / "study.toml").read_text()
     study = re.sub(r"(?m)^samples = \d+", "samples = " + str(rng.choice([0, 0, 0, 5])), study)
+    if kind == "law":
+        # A coefficient set read from a restitution law file (a law alone or a
+        # summary.json holding one), the file mutated; drawn in the ensembles.
+        law = (FIX / "facade" / "law.json").read_text()
+        if rng.random() < 0.5:
+            law = '{"campaign": "c", "restitution_law": ' + law + "}"
+        (work / "f" / "law.json").write_text(law)
+        desc = mutate_file(rng, work / "f" / "law.json", rng.choice(["toml", "text"]))
+        study += '\n[[coefficients]]\nname = "law"\nlaw = "law.json"\n'
+        (work / "f" / "study.toml").write_text(study)
+        return kind, f"law.json {desc}", ["facade", str(work / "f" / "study.toml"), "--out", str(out)]
     (work / "f" / "study.toml").write_text(study)
     record = rng.choice(["synthetic/one_sine_pulse_nga.AT2", "synthetic/one_sine_pulse_old.AT2",
                          "esm-central-italy-2016/IT.NRC..HGE.D.20160824.013632.C.ACC.ASC"])
@@ -291,7 +313,8 @@ def non_finite(path):
             elif isinstance(v, list):
                 for i, x in enumerate(v):
                     walk(x, key, f"{path}[{i}]")
-            elif v is None and key in NUMERIC_JSON:
+            elif v is None and key in NUMERIC_JSON and not (key == "e_housner" and ".law." in path):
+                # (a law set's e_housner is null when e_H is Eq. 2's, by design)
                 bad.append(path)
         walk(doc, "", "")
         return f"null {bad[0]} in JSON" if bad else None
@@ -349,7 +372,8 @@ def run_case(seed, i):
                 problems.append(f"modified (deleted) {p_.relative_to(sandbox)}")
         if code == 0:
             for p_ in after:
-                if out in p_.parents:
+                # (init's --out holds its inputs, the logs: only what the run wrote)
+                if out in p_.parents and p_ not in inputs:
                     nf = non_finite(p_)
                     if nf:
                         problems.append(f"nonfinite {p_.name}: {nf}")
@@ -373,7 +397,7 @@ def main():
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--bin", type=Path, default=BIN, help="the binary to run (default target/release/rocklab)")
     a = ap.parse_args()
-    BIN = a.bin
+    BIN = a.bin.resolve()  # the cases run with their sandbox as the working folder
     if not BIN.exists():
         sys.exit(f"{BIN} not found: cargo build --release")
     counts = {"cases": 0, "exit0": 0, "exit2": 0, "other_exit": 0, "crash": 0, "hang": 0, "nonfinite": 0, "escape": 0,

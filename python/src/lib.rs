@@ -385,6 +385,9 @@ fn simulate_pair(
 #[pyo3(signature = (manifest, impacts=6))]
 fn calibrate(py: Python<'_>, manifest: PathBuf, impacts: usize) -> PyResult<String> {
     let doc = guarded(py, move || {
+        rocklab::limits::CALIBRATION_IMPACTS
+            .check("impacts", impacts as f64)
+            .map_err(anyhow::Error::msg)?;
         let campaign = Campaign::load(&manifest)?;
         let res = reduce_campaign(campaign, PeakOptions::default());
         let start = Instant::now();

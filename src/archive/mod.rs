@@ -179,6 +179,30 @@ pub fn add_with_hook(archive: &Path, report_dirs: &[PathBuf], hook: &mut dyn FnM
             .map_err(table_err(archive))?
             .height();
         reductions.push((r.campaign.clone(), r.sha256.clone(), r.tests.height(), r.impacts.height(), replaced));
+        // The same campaign from another manifest (a typo fixed in it, then
+        // reduced again) is another key: both are kept, and the user is told.
+        let others = old_tests
+            .clone()
+            .lazy()
+            .filter(
+                col("campaign")
+                    .eq(lit(r.campaign.as_str()))
+                    .and(col("manifest_sha256").neq(lit(r.sha256.as_str()))),
+            )
+            .collect()
+            .map_err(table_err(archive))?;
+        let other_shas: std::collections::BTreeSet<String> = others
+            .column("manifest_sha256")
+            .and_then(|c| c.str().map(|s| s.iter().flatten().map(|x| x[..x.len().min(12)].to_string()).collect()))
+            .map_err(table_err(archive))?;
+        if !other_shas.is_empty() {
+            notes.push(format!(
+                "{} is also in the archive from another manifest ({}…, {} tests): both are kept, as two reductions (was the manifest corrected? its old rows stay until a reduction of that manifest replaces them); the archive page shows each with its manifest, and SQL tells them apart by manifest_sha256",
+                r.campaign,
+                other_shas.into_iter().collect::<Vec<_>>().join("…, "),
+                others.height()
+            ));
+        }
     }
     let mut tables = Vec::new();
     for name in TABLES {

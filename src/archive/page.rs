@@ -16,10 +16,13 @@ use crate::report::plots::{self, Panel, Series};
 /// One archived test, as the page needs it.
 struct Point {
     campaign: String,
+    sha: String,
     rocking: String,
     slenderness: f64,
     r_plus: (f64, Option<f64>),
     r_minus: (f64, Option<f64>),
+    /// In its campaign's means (not `exclude_from_mean`).
+    in_mean: bool,
 }
 
 fn text(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<String>>> {
@@ -33,6 +36,7 @@ fn numbers(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<f64>>> {
 /// The plotted tests: status "ok", slenderness and both ratios known.
 fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
     let (campaign, rocking, status) = (text(df, "campaign")?, text(df, "rocking")?, text(df, "status")?);
+    let sha = text(df, "manifest_sha256")?;
     let (sl, rp, rpu, rm, rmu) = (
         numbers(df, "slenderness")?,
         numbers(df, "r_plus")?,
@@ -40,6 +44,7 @@ fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
         numbers(df, "r_minus")?,
         numbers(df, "r_minus_u")?,
     );
+    let excluded: Vec<Option<bool>> = df.column("exclude_from_mean")?.bool()?.iter().collect();
     let mut out = Vec::new();
     for i in 0..df.height() {
         if status[i].as_deref() != Some("ok") {
@@ -48,10 +53,12 @@ fn points(df: &DataFrame) -> PolarsResult<(Vec<Point>, usize)> {
         if let (Some(s), Some(p), Some(m)) = (sl[i], rp[i], rm[i]) {
             out.push(Point {
                 campaign: campaign[i].clone().unwrap_or_default(),
+                sha: sha[i].clone().unwrap_or_default(),
                 rocking: rocking[i].clone().unwrap_or_default(),
                 slenderness: s,
                 r_plus: (p, rpu[i]),
                 r_minus: (m, rmu[i]),
+                in_mean: excluded[i] != Some(true),
             });
         }
     }
@@ -167,31 +174,72 @@ pub fn render(tests: &DataFrame, impacts: &DataFrame) -> Result<String, ArchiveE
         page.figure(
             &fig.svg,
             &format!(
-                "r = e/e_H of every archived impact ({} of tests with status ok) against the amplitude of the half-cycle it ends, by campaign: the data a restitution law r(a) is fitted to (docs/restitution-law.md).",
+                "r = e/e_H of every archived impact ({} impacts of the tests with status ok) against the amplitude of the half-cycle it ends, by campaign: the data a restitution law r(a) is fitted to (docs/restitution-law.md).",
                 ipts.len()
             ),
         );
     }
-    let mut by: BTreeMap<(String, String), Vec<&Point>> = BTreeMap::new();
-    for p in &pts {
-        by.entry((p.campaign.clone(), p.rocking.clone())).or_default().push(p);
+    // Every archived campaign has a row, also one whose tests are all suspect
+    // (it was missing from the table, as if not archived).
+    let page_err = |e: PolarsError| ArchiveError::Page(e.to_string());
+    let (campaign, rocking) = (text(tests, "campaign").map_err(page_err)?, text(tests, "rocking").map_err(page_err)?);
+    let slenderness = numbers(tests, "slenderness").map_err(page_err)?;
+    let sha = text(tests, "manifest_sha256").map_err(page_err)?;
+    // A row per reduction (campaign and manifest): a campaign reduced again from a
+    // corrected manifest is two reductions, never merged into one mean.
+    type Group<'a> = (usize, Option<f64>, Vec<&'a Point>);
+    let mut by: BTreeMap<(String, String, String), Group> = BTreeMap::new();
+    for i in 0..tests.height() {
+        let key = (
+            campaign[i].clone().unwrap_or_default(),
+            sha[i].clone().unwrap_or_default(),
+            rocking[i].clone().unwrap_or_default(),
+        );
+        let g = by.entry(key).or_insert((0, None, Vec::new()));
+        g.0 += 1;
+        g.1 = g.1.or(slenderness[i]);
     }
-    let mean = |v: &[&Point], f: fn(&Point) -> f64| v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64;
+    for p in &pts {
+        if let Some(g) = by.get_mut(&(p.campaign.clone(), p.sha.clone(), p.rocking.clone())) {
+            g.2.push(p);
+        }
+    }
+    let mut names: BTreeMap<&str, usize> = BTreeMap::new();
+    for (c, _, _) in by.keys() {
+        *names.entry(c.as_str()).or_default() += 1;
+    }
+    // The campaign's means: its tests with status ok that the manifest does not
+    // leave out (`exclude_from_mean`), as its Table 1 has them.
+    let mean = |v: &[&&Point], f: fn(&Point) -> f64| (!v.is_empty()).then(|| format!("{:.3}", v.iter().map(|p| f(p)).sum::<f64>() / v.len() as f64));
     let rows: Vec<Vec<String>> = by
         .iter()
-        .map(|((c, r), v)| {
+        .map(|((c, sha, r), (n, sl, v))| {
+            let inc: Vec<&&Point> = v.iter().filter(|p| p.in_mean).collect();
+            let none = || "— (no test in the means)".to_string();
+            let name = if names[c.as_str()] > 1 {
+                format!("{c} (manifest {}…)", &sha[..sha.len().min(12)])
+            } else {
+                c.clone()
+            };
             vec![
-                c.clone(),
+                name,
                 r.clone(),
-                format!("{:.2}", v[0].slenderness),
+                sl.map_or_else(|| "—".to_string(), |x| format!("{x:.2}")),
+                n.to_string(),
                 v.len().to_string(),
-                format!("{:.3}", mean(v, |p| p.r_plus.0)),
-                format!("{:.3}", mean(v, |p| p.r_minus.0)),
+                inc.len().to_string(),
+                mean(&inc, |p| p.r_plus.0).unwrap_or_else(none),
+                mean(&inc, |p| p.r_minus.0).unwrap_or_else(none),
             ]
         })
         .collect();
     page.h2("Campaigns");
-    page.table("meta", &["campaign", "rocking", "h/t", "tests ok", "mean r⁺", "mean r⁻"], &rows);
+    page.p("Mean r⁺ and r⁻ of each campaign's tests with status ok that its manifest keeps in the means (not exclude_from_mean): the means of its Table 1.");
+    page.table(
+        "meta",
+        &["campaign", "rocking", "h/t", "tests", "tests ok", "in the mean", "mean r⁺", "mean r⁻"],
+        &rows,
+    );
     Ok(page.finish())
 }
 

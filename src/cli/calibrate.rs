@@ -32,6 +32,11 @@ pub struct CalibrateArgs {
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<ExitCode> {
+    // Before the reduction: `--impacts 0` once left every test out as having
+    // "fewer than 0 impacts".
+    rocklab::limits::CALIBRATION_IMPACTS
+        .check("--impacts", a.impacts as f64)
+        .map_err(anyhow::Error::msg)?;
     let campaign = Campaign::load(&a.manifest)?;
     let sources = load::campaign_sources(&campaign);
     let res = super::reduce::reduce_with_progress(campaign, PeakOptions::default());

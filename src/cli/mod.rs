@@ -104,6 +104,17 @@ pub struct DemoArgs {
 
 pub fn run() -> anyhow::Result<ExitCode> {
     let cli = Cli::parse();
+    let out = match &cli.command {
+        Command::Reduce(a) => Some(&a.out),
+        Command::Simulate(a) => Some(&a.out),
+        Command::Facade(a) => Some(&a.out),
+        Command::Calibrate(a) => Some(&a.out),
+        Command::Demo(a) => Some(&a.out),
+        Command::Init(_) | Command::Archive(_) => None,
+    };
+    if let Some(out) = out {
+        check_out(out)?;
+    }
     match cli.command {
         Command::Init(a) => init::run(a),
         Command::Reduce(a) => reduce::run(a),
@@ -112,6 +123,20 @@ pub fn run() -> anyhow::Result<ExitCode> {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Archive(a) => archive::run(a),
+    }
+}
+
+/// Refuse an output folder that is a file before any work is done (the writer
+/// would refuse it too, but only after a reduction or a study of minutes).
+fn check_out(out: &std::path::Path) -> anyhow::Result<()> {
+    let existing = out.ancestors().filter(|a| !a.as_os_str().is_empty()).find(|a| a.exists());
+    match existing {
+        Some(at) if !at.is_dir() => anyhow::bail!(
+            "--out {}: {} is a file, not a folder (the outputs are several files: name a folder, new or existing)",
+            out.display(),
+            at.display()
+        ),
+        _ => Ok(()),
     }
 }
 

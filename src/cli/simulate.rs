@@ -147,6 +147,9 @@ pub fn run_cli(a: SimulateArgs) -> anyhow::Result<ExitCode> {
     let (summary, sim) = run(&block, &record, &spec)?;
     let alpha = block.block.alpha;
     let mut files = Files::default();
+    for input in [Some(&a.block), Some(&a.record), a.calibration.as_ref()].into_iter().flatten() {
+        files.input(input);
+    }
     let doc = docs::simulate_summary(&block, &a.record.display().to_string(), &record, &spec, &summary, &sim)?;
     files.add("summary.json", serde_json::to_vec_pretty(&doc)?);
     files.add("history.csv", response::history_csv(&sim.history, alpha)?);

@@ -29,12 +29,32 @@ pub fn read(path: &Path) -> Result<RestitutionLaw, FileError> {
     // The law is parsed from its own text, so that an error inside it is located
     // in the file (serde_json places the errors of a Value without positions).
     let start = law_offset(&text);
+    let position = |at: usize| {
+        let before = &text[..at];
+        let line = before.matches('\n').count() + 1;
+        (line, before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1)
+    };
+    // A reduction that could fit no law writes {"error": why} in its place: say
+    // that, and why, rather than a missing `form`.
+    if let Some(why) = value.get("restitution_law").and_then(|l| l.get("error")).and_then(|e| e.as_str()) {
+        let (line, column) = position(start);
+        return Err(FileError::Invalid {
+            file: path.to_path_buf(),
+            line: Some(line),
+            column: Some(column),
+            message: crate::error::excerpt_text(
+                &format!(
+                    "restitution_law: the reduction fitted no law to this campaign ({why}); a façade set cannot use it: give the set e_in and e_out, or calibration = FILE"
+                ),
+                400,
+            ),
+        });
+    }
     let slice = &text[start..];
     let mut de = serde_json::Deserializer::from_str(slice);
     let parsed: RestitutionLaw = serde::Deserialize::deserialize(&mut de).map_err(|e| {
-        let before = &text[..start];
-        let line0 = before.matches('\n').count();
-        let col0 = before.rsplit('\n').next().map_or(0, |l| l.chars().count());
+        let (line0, col0) = position(start);
+        let (line0, col0) = (line0 - 1, col0 - 1);
         let (line, column) = if e.line() <= 1 {
             (line0 + 1, col0 + e.column())
         } else {

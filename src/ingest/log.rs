@@ -252,7 +252,7 @@ impl LogReader {
         }
         // The csv reader does not count skipped '#' lines in the header's position.
         let header_line = header_line_number(bytes);
-        let names: Vec<String> = rec.iter().map(|f| String::from_utf8_lossy(f).trim().to_string()).collect();
+        let names: Vec<String> = rec.iter().map(|f| header_name(f).trim().to_string()).collect();
         let find = |name: &str, what: &str| {
             names.iter().position(|n| n == name).ok_or_else(|| InputError::Line {
                 file: file.clone(),
@@ -510,6 +510,17 @@ fn parse_cell(cell: &[u8], decimal: Decimal, buf: &mut Vec<u8>) -> Result<f64, S
     Ok(v)
 }
 
+/// A header field as text: UTF-8, else Latin-1 (each byte its character;
+/// Windows-1252 agrees on µ, °, ±, é), so that a logger writing 'disp_µm' in
+/// Latin-1 matches a manifest's "disp_µm" instead of reading 'disp_\u{fffd}m'.
+/// `init` names the columns it drafts by the same rule.
+pub(crate) fn header_name(field: &[u8]) -> String {
+    match std::str::from_utf8(field) {
+        Ok(t) => t.to_string(),
+        Err(_) => field.iter().map(|&b| char::from(b)).collect(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -533,6 +544,19 @@ mod tests {
         assert_eq!(d.time_s, vec![0.0, 0.005]);
         assert_eq!(d.disp_mm, vec![1.5, -2.25]);
         assert!(d.notes.iter().any(|n| n.contains("detected")));
+    }
+
+    // Session 13: a logger writing its header in Latin-1 ('disp_\xb5m') could not
+    // be matched by any manifest: the name read as 'disp_\u{fffd}m'.
+    #[test]
+    fn a_latin1_header_matches_its_name() {
+        let d = LogReader::new("t.csv")
+            .displacement("disp_µm", 1e-3)
+            .parse(b"# Prova n\xb0 1\ntime_s,disp_\xb5m\n0,1500\n0.005,1250\n")
+            .unwrap();
+        assert_eq!(d.disp_mm, vec![1.5, 1.25]);
+        let e = reader().parse(b"time_s,disp_\xb5m\n0,1\n").unwrap_err().to_string();
+        assert!(e.contains("(columns: time_s, disp_µm)"), "{e}");
     }
 
     #[test]

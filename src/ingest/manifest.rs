@@ -533,7 +533,26 @@ fn validate(raw: RawManifest, path: &Path) -> Result<Campaign> {
         if !seen.insert(t.id.clone()) {
             return Err(bad(path, format!("[[test]] id = {:?}: duplicate test id", t.id)));
         }
-        tests.push(validate_test(t, &defaults, path)?);
+        let test = validate_test(t, &defaults, path)?;
+        // One run of the wall is one test: two tests reading the same channels of
+        // the same log (a copied [[test]] block whose file was not changed) would
+        // count that run twice in the means.
+        let same = |o: &TestSpec| {
+            o.file == test.file
+                && format!("{:?}", o.source) == format!("{:?}", test.source)
+                && o.time.column == test.time.column
+                && o.displacement.column == test.displacement.column
+        };
+        if let Some(first) = tests.iter().find(|o| same(o)) {
+            return Err(bad(
+                path,
+                format!(
+                    "[[test]] id = {:?}: file = {:?} is the log of test {:?} too, read through the same channels: one run would count twice in the means (a copied [[test]] block whose file was not changed?)",
+                    t.id, t.file, first.id
+                ),
+            ));
+        }
+        tests.push(test);
     }
     Ok(Campaign {
         manifest_sha256: String::new(),
@@ -606,6 +625,23 @@ time = { column = "t_ms", unit = "ms" }
         assert_eq!(c.tests[0].file, Path::new("/x/a.csv"));
         assert!(matches!(c.alpha_source, Provenance::Computed(_)));
         assert!((c.e_housner - 0.9738).abs() < 1e-4);
+    }
+
+    // Session 13: a [[test]] block copied without changing its file read the same
+    // run twice, which then counted twice in the means, without a word.
+    #[test]
+    fn two_tests_reading_the_same_channels_of_one_log_are_refused() {
+        let copied = format!("{BASE}[[test]]\nid = \"a2\"\nfile = \"a.csv\"\n");
+        let err = Campaign::parse(&copied, Path::new("m.toml")).unwrap_err().to_string();
+        assert!(
+            err.contains("m.toml:22:1: [[test]] id = \"a2\": file = \"a.csv\" is the log of test \"a\" too"),
+            "{err}"
+        );
+        // Another channel of the same log (a second sensor) is another reading.
+        let other =
+            format!("{BASE}[[test]]\nid = \"c\"\nfile = \"a.csv\"\ndisplacement = {{ column = \"disp2_mm\", unit = \"mm\", height_m = 2.0 }}\n");
+        let c = Campaign::parse(&other, Path::new("m.toml")).unwrap();
+        assert_eq!(c.tests.len(), 3);
     }
 
     #[test]

@@ -110,16 +110,23 @@ pub fn survey_log(name: &str, bytes: &[u8]) -> Result<LogSurvey, String> {
         .collect();
     let mut notes = Vec::new();
     let (delimiter, decimal) = LogReader::new(name).resolve_format(bytes, &mut notes).map_err(|e| e.to_string())?;
-    let header = text
-        .lines()
-        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
-        .unwrap_or("");
+    let header = bytes
+        .split(|&b| b == b'\n')
+        .find(|l| {
+            let l = String::from_utf8_lossy(l);
+            !l.trim().is_empty() && !l.trim_start().starts_with('#')
+        })
+        .unwrap_or_default();
     let sep = match delimiter {
-        Delimiter::Comma => ',',
-        Delimiter::Semicolon => ';',
-        Delimiter::Tab => '\t',
+        Delimiter::Comma => b',',
+        Delimiter::Semicolon => b';',
+        Delimiter::Tab => b'\t',
     };
-    let columns: Vec<String> = header.split(sep).map(|c| c.trim().trim_matches('"').to_string()).collect();
+    // Each name as the log reader reads it (UTF-8, else Latin-1).
+    let columns: Vec<String> = header
+        .split(|&b| b == sep)
+        .map(|c| crate::ingest::log::header_name(c).trim().trim_matches('"').to_string())
+        .collect();
     let time_col = columns
         .iter()
         .find(|c| is_time(c))
@@ -550,6 +557,16 @@ mod tests {
         assert_eq!((s.outward_sign, s.rows, s.stated_rate_hz), (Some(1), 4, Some(200.0)));
         assert!((s.step_s - 0.005).abs() < 1e-12 && rate_text(s.step_s) == "200", "{}", s.step_s);
         assert_eq!(s.id, "w_1");
+    }
+
+    // Session 13: a Latin-1 header 'disp_\xb5m' was drafted as column "disp_\u{fffd}m",
+    // which no log reader could then find.
+    #[test]
+    fn a_latin1_header_is_drafted_as_the_reader_reads_it() {
+        let s = survey_log("l.csv", b"# Prova n\xb0 1\ntime_s,disp_\xb5m\n0,1\n0.005,1\n0.01,1\n").unwrap();
+        assert_eq!(s.displacement.as_ref().unwrap().column, "disp_µm");
+        let reader = LogReader::new("l.csv").displacement(&s.displacement.unwrap().column, 1e-3);
+        assert_eq!(reader.parse(b"time_s,disp_\xb5m\n0,1000\n0.005,2000\n").unwrap().disp_mm, vec![1.0, 2.0]);
     }
 
     #[test]

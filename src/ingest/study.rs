@@ -457,6 +457,12 @@ impl Study {
             rtol: h.rtol.unwrap_or(1e-8),
             records,
             sets,
+            coefficient_files: raw
+                .coefficients
+                .iter()
+                .filter_map(|s| s.calibration.as_deref().or(s.law.as_deref()))
+                .map(|f| base.join(f))
+                .collect(),
             e_housner_eq2: housner_e(block.block.alpha),
             block,
         })

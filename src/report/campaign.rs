@@ -37,6 +37,9 @@ pub type TestFigures = Vec<(String, Figure, Figure)>;
 /// self-contained report.html, with what `extra` adds.
 pub fn reduce_files(res: &CampaignResult, sources: &Sources, with_plots: bool, extra: &Extras) -> Result<Files, ReportError> {
     let mut files = Files::default();
+    for f in &sources.files {
+        files.input(&f.path);
+    }
     let mut doc = super::summary::summary(res)?;
     if let Some(map) = doc.as_object_mut() {
         map.extend(extra.summary.clone());

@@ -56,6 +56,9 @@ pub fn ensemble_source(runs: usize, records: usize) -> String {
 /// printed on the terminal).
 pub fn facade_files(study: &Study, res: &FacadeResults, inputs: &[InputFile]) -> Result<(Files, String)> {
     let mut files = Files::default();
+    for f in inputs.iter().map(|i| &i.path).chain(&study.coefficient_files) {
+        files.input(f);
+    }
     let mut tables = Vec::new();
     if let Some((rows, samples)) = &res.ensemble {
         tables.push(ensemble_table(study, rows, &res.runs));

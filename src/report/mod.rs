@@ -1,6 +1,6 @@
 //! The output edge: the `summary.json` contract, the tables (one model, four
 //! formats), the plots and the HTML pages. Every renderer returns bytes into a
-//! [`Files`]; [`write_files`] is the one function that writes them (atomically).
+//! [`Files`]; [`write_files`] is the one function that writes them (atomically, as a set).
 //! The inputs a page names in its provenance arrive as [`InputFile`]s, read and
 //! hashed by the load step; nothing here reads a file.
 
@@ -75,51 +75,88 @@ pub(crate) fn json_value<T: serde::Serialize>(doc: &T) -> Result<serde_json::Val
     Ok(serde_json::to_value(doc)?)
 }
 
-/// Files to write, by path relative to the output folder, in order.
+/// Files to write, by path relative to the output folder, in order, and the
+/// inputs of the run, which no output may replace.
 #[derive(Debug, Default)]
-pub struct Files(Vec<(PathBuf, Vec<u8>)>);
+pub struct Files {
+    files: Vec<(PathBuf, Vec<u8>)>,
+    inputs: Vec<PathBuf>,
+}
 
 impl Files {
     pub fn add(&mut self, path: impl Into<PathBuf>, bytes: impl Into<Vec<u8>>) {
-        self.0.push((path.into(), bytes.into()));
+        self.files.push((path.into(), bytes.into()));
     }
     pub fn append(&mut self, other: Files) {
-        self.0.extend(other.0);
+        self.files.extend(other.files);
+        self.inputs.extend(other.inputs);
     }
     /// The bytes of `path`, if a renderer produced it.
     pub fn get(&self, path: &str) -> Option<&[u8]> {
-        self.0.iter().find(|(p, _)| p == Path::new(path)).map(|(_, b)| b.as_slice())
+        self.files.iter().find(|(p, _)| p == Path::new(path)).map(|(_, b)| b.as_slice())
     }
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
-        self.0.iter().map(|(p, _)| p.as_path())
+        self.files.iter().map(|(p, _)| p.as_path())
+    }
+    /// A file the run read (a manifest, a log, a record…): [`write_files`]
+    /// refuses a set that would replace it. `--out` may be the inputs' own
+    /// folder; a log that happens to be named `table1.csv` there stays the log.
+    pub fn input(&mut self, path: impl Into<PathBuf>) {
+        self.inputs.push(path.into());
     }
 }
 
-/// The one writer: every file under `dir` (folders created), each atomically
-/// ([`crate::atomic::write_under`]: a temporary sibling, then a rename).
+/// The one writer: every file under `dir` (folders created) as one set
+/// ([`crate::atomic::write_set_under`]: each staged as a temporary sibling, then
+/// all renamed into place).
 /// Before the first byte is written, every file is checked ([`check_files`]): a
 /// path that would leave `dir` (by its names or through a folder that is a
 /// symbolic link), two files under one path, or a non-finite number in a text
-/// output refuses the whole set, so a failed run writes nothing.
+/// output refuses the whole set, and so does an output that would replace one of
+/// the run's inputs ([`Files::input`]); a failure while staging (a full disk)
+/// removes what was staged: a failed run writes nothing.
 pub fn write_files(dir: &Path, files: &Files) -> Result<(), ReportError> {
     check_files(files)?;
-    for (rel, _) in &files.0 {
-        crate::atomic::check_no_link(dir, rel).map_err(|why| ReportError::Path {
-            path: crate::error::excerpt(&rel.to_string_lossy(), 60),
-            why,
-        })?;
+    for (rel, _) in &files.files {
+        let shown = || crate::error::excerpt(&rel.to_string_lossy(), 60);
+        crate::atomic::check_no_link(dir, rel).map_err(|why| ReportError::Path { path: shown(), why })?;
+        if let Some(input) = files.inputs.iter().find(|i| same_file(&dir.join(rel), i)) {
+            return Err(ReportError::Path {
+                path: shown(),
+                why: format!(
+                    "{} is an input of this run: refusing to replace it (write the outputs to a folder apart from the inputs)",
+                    crate::error::excerpt(&input.display().to_string(), 200)
+                ),
+            });
+        }
     }
-    for (rel, bytes) in &files.0 {
-        crate::atomic::write_under(dir, rel, bytes).map_err(|source| ReportError::Write { path: dir.join(rel), source })?;
+    crate::atomic::write_set_under(dir, &files.files).map_err(|(path, source)| ReportError::Write { path, source })
+}
+
+/// Whether `a` and `b` name one existing file (the same entry: device and inode
+/// where the platform has them, else the same canonical path). A symbolic link
+/// is the link itself, as the writer's rename replaces the link, not its target.
+fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::symlink_metadata(a), std::fs::symlink_metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        ma.dev() == mb.dev() && ma.ino() == mb.ino()
     }
-    Ok(())
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
+    }
 }
 
 /// Every path relative, made of plain components (no `..`, root, prefix, NUL,
 /// component over 255 bytes), each path once; every text output finite.
 pub fn check_files(files: &Files) -> Result<(), ReportError> {
     let mut seen = std::collections::HashSet::new();
-    for (rel, bytes) in &files.0 {
+    for (rel, bytes) in &files.files {
         let shown = || crate::error::excerpt(&rel.to_string_lossy(), 60);
         crate::atomic::check_relative(rel).map_err(|why| ReportError::Path { path: shown(), why })?;
         if !seen.insert(rel.as_path()) {

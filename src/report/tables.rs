@@ -212,7 +212,11 @@ fn build(v: &CampaignView, name: &'static str, caption: String, cols: Cols) -> T
 }
 
 fn mean_label(means: &CampaignMeans) -> String {
-    if means.left_out.is_empty() {
+    if let (None, [only]) = (&means.means_u, means.included.as_slice()) {
+        // One test: the "mean" is its values, and there is no spread between
+        // tests to give it a ± (the row would read as a bare, exact-looking 82%).
+        format!("mean = {only} alone (one test: no spread between tests, so no ±)")
+    } else if means.left_out.is_empty() {
         "mean".to_string()
     } else {
         let ids: Vec<&str> = means.left_out.iter().map(|(id, _)| id.as_str()).collect();
@@ -302,5 +306,24 @@ mod tests {
         assert_eq!(value_u(0.916, 0.012), "0.916 ± 0.012");
         assert_eq!(value_u(0.5, 0.0), "0.500 ± 0.000");
         assert_eq!(value_u(0.5, f64::NAN), "0.500 (u not computed)");
+    }
+
+    // Session 13: on the engine campaign fresh-one-default four of five tests are
+    // suspect, and the mean row read "mean (without …) 82% 81% 80%": one test's
+    // values, without ± and without saying so.
+    #[test]
+    fn a_mean_of_one_test_says_so() {
+        let m = CampaignMeans {
+            means: None,
+            means_u: None,
+            included: vec!["F1_180_1".into()],
+            left_out: vec![("F1_190_1".into(), "suspect".into())],
+        };
+        assert_eq!(mean_label(&m), "mean = F1_180_1 alone (one test: no spread between tests, so no ±)");
+        let two = CampaignMeans {
+            included: vec!["a".into(), "b".into()],
+            ..m.clone()
+        };
+        assert_eq!(mean_label(&two), "mean (without F1_190_1)");
     }
 }

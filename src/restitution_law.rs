@@ -273,6 +273,31 @@ impl RestitutionLaw {
         (self.r(side, amplitude_over_alpha) * e_h).min(1.0)
     }
 
+    /// The smallest amplitude a ∈ [amplitude_min, 1] at which the solver's
+    /// e = min(1, r(a) e_H) reaches its cap 1 (a perfectly elastic impact), to 0.1 %
+    /// of a; `None` where it never does. r(a) = r∞ − c g(a) is monotone in a for
+    /// either sign of c, so the first of 400 points spaced evenly in ln a that
+    /// reaches the cap, refined by bisection, is the one.
+    pub fn elastic_from(&self, side: Side, e_h: f64) -> Option<f64> {
+        let capped = |a: f64| self.r(side, a) * e_h >= 1.0;
+        let lo = self.parameters.amplitude_min.clamp(AMPLITUDE_FLOOR, 1.0);
+        let at = |i: usize| lo * (1.0 / lo).powf(i as f64 / 399.0);
+        let first = (0..400).find(|&i| capped(at(i)))?;
+        if first == 0 {
+            return Some(lo);
+        }
+        let (mut below, mut above) = (at(first - 1), at(first));
+        while above - below > 1e-3 * above {
+            let mid = 0.5 * (below + above);
+            if capped(mid) {
+                above = mid;
+            } else {
+                below = mid;
+            }
+        }
+        Some(above)
+    }
+
     /// `n` (at least 20) points spaced evenly in ln a over the observed amplitudes
     /// [amplitude_min, amplitude_max], with r and u(r) on each side.
     pub fn curve(&self, n: usize) -> Vec<CurvePoint> {
@@ -344,6 +369,38 @@ impl RestitutionLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The public one-sided campaign's outward law (r∞ 1.1614, c 0.0415, e_H 0.9738):
+    /// r e_H = 1 where g = (1.1614 − 1/0.9738)/0.0415, a(2 − a) = 1/g²; a constant
+    /// below 1/e_H never reaches the cap, one above it does from the start.
+    #[test]
+    fn the_law_reaches_an_elastic_impact_where_r_e_h_is_one() {
+        let side = |r_inf: f64, c: f64| SideLaw {
+            r_inf,
+            c,
+            cov: [[0.0; 2]; 2],
+        };
+        let law = |form, inward, outward| RestitutionLaw {
+            form,
+            parameters: LawParameters {
+                inward,
+                outward,
+                shared: false,
+                amplitude_min: 0.0024,
+                amplitude_max: 0.391,
+            },
+        };
+        let l = law(LawForm::SpeedLoss, side(0.6714, 0.0), side(1.1614, 0.0415));
+        let g: f64 = (1.1614 - 1.0 / 0.9738) / 0.0415;
+        let want = 1.0 - (1.0 - 1.0 / (g * g)).sqrt();
+        let got = l.elastic_from(Side::Outward, 0.9738).unwrap();
+        assert!((got / want - 1.0).abs() < 2e-3, "{got} vs {want}");
+        assert!(l.e(Side::Outward, got, 0.9738) == 1.0 && l.e(Side::Outward, 0.998 * want, 0.9738) < 1.0);
+        assert_eq!(l.elastic_from(Side::Inward, 0.9738), None);
+        let c = law(LawForm::Constant, side(1.05, 0.0), side(0.9, 0.0));
+        assert_eq!(c.elastic_from(Side::Inward, 0.9738), Some(0.0024));
+        assert_eq!(c.elastic_from(Side::Outward, 0.9738), None);
+    }
 
     fn law() -> RestitutionLaw {
         RestitutionLaw {

@@ -189,10 +189,12 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
         .sets
         .iter()
         .map(|s| {
-            let law = if s.law_at(study.block.block.alpha).is_some() {
-                ", the law's e at a = 1"
-            } else {
-                ""
+            let law = match s.law_at(study.block.block.alpha) {
+                Some((law, e_h)) => {
+                    let range = law_range(&law, e_h);
+                    format!(", the law's e at a = 1{}{range}", if range.is_empty() { "" } else { "; " })
+                }
+                None => String::new(),
             };
             format!(
                 "{} (e_in {}, e_out {}{law}, {})",
@@ -468,7 +470,7 @@ fn ensemble_caption(study: &Study) -> String {
     let sets = study
         .sets
         .iter()
-        .map(|s| format!("{} {}", s.name, describe_set(s)))
+        .map(|s| format!("{} {}", s.name, describe_set(s, study.block.block.alpha)))
         .collect::<Vec<_>>()
         .join("; ");
     format!(
@@ -477,13 +479,36 @@ fn ensemble_caption(study: &Study) -> String {
     )
 }
 
-fn describe_set(s: &CoefficientSet) -> String {
+/// Where a law set's coefficients sit at the cap: per side, the amplitude from which
+/// the solver's e = min(1, r(a) e_H) is 1 (a perfectly elastic impact), beside the
+/// amplitudes of the campaign's impacts (a speed-loss law; a constant has none).
+fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64) -> String {
+    use crate::restitution_law::LawForm;
+    use crate::wall::Side;
+    let (lo, hi) = (law.parameters.amplitude_min, law.parameters.amplitude_max);
+    let mut parts = Vec::new();
+    if law.form == LawForm::SpeedLoss {
+        parts.push(format!("the campaign's impacts span a = |θ|/α = {lo:.3}–{hi:.3}"));
+    }
+    for (side, name) in [(Side::Inward, "inward"), (Side::Outward, "outward")] {
+        if let Some(a) = law.elastic_from(side, e_h) {
+            parts.push(format!("{name} e = 1 (the cap: an elastic impact) from a = {a:.3}"));
+        }
+    }
+    parts.join("; ")
+}
+
+fn describe_set(s: &CoefficientSet, alpha: f64) -> String {
     use crate::ensemble::CoefficientDist;
+    let range = match s.law_at(alpha).map(|(law, e_h)| law_range(&law, e_h)) {
+        Some(r) if !r.is_empty() => format!("; {r}"),
+        _ => String::new(),
+    };
     match s.dist {
         CoefficientDist::Single(d) => format!("(e {}, {})", d.describe(), s.source),
         CoefficientDist::Pair { e_in, e_out } => format!("(e_in {}, e_out {}, {})", e_in.describe(), e_out.describe(), s.source),
         CoefficientDist::Law { drawn, .. } => format!(
-            "(law, {}; e at a = 1: in {}, out {}; {})",
+            "(law, {}; e at a = 1: in {}, out {}{range}; {})",
             if drawn {
                 "parameters drawn from their covariance"
             } else {

@@ -77,13 +77,23 @@ pub fn write_set_under(root: &Path, files: &[(PathBuf, Vec<u8>)]) -> Result<(), 
         check_no_link(root, rel).map_err(|why| refuse(rel, why))?;
     }
     let (mut created, mut staged) = (Vec::new(), Vec::new());
+    let mut swept: Vec<PathBuf> = Vec::new();
     let result = (|| {
         for (rel, bytes) in files {
             let path = root.join(rel);
             let dir = path.parent().unwrap_or(root);
             create_folders(dir, &mut created)?;
             let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
-            remove_stale_temporaries(dir, &name);
+            if !swept.iter().any(|d| d == dir) {
+                let names: Vec<String> = files
+                    .iter()
+                    .map(|(r, _)| root.join(r))
+                    .filter(|p| p.parent().unwrap_or(root) == dir)
+                    .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                    .collect();
+                remove_stale_temporaries(dir, &names);
+                swept.push(dir.to_path_buf());
+            }
             let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
             staged.push((tmp.clone(), path.clone()));
             write_synced(&tmp, bytes).map_err(|e| (path.clone(), e))?;
@@ -130,15 +140,18 @@ fn create_folders(dir: &Path, created: &mut Vec<PathBuf>) -> Result<(), (PathBuf
 
 /// Remove the temporaries `.NAME.tmp-PID` in `dir` that a killed run left: those
 /// of a process that no longer runs (known from `/proc`; elsewhere none is
-/// removed, as a live run's may not be).
-fn remove_stale_temporaries(dir: &Path, name: &str) {
-    let prefix = format!(".{name}.tmp-");
+/// removed, as a live run's may not be), for the `names` the set writes there.
+/// One read of the folder per set.
+fn remove_stale_temporaries(dir: &Path, names: &[String]) {
     let proc_fs = Path::new("/proc/self").exists();
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for entry in entries.flatten() {
         let file = entry.file_name().to_string_lossy().into_owned();
         let Some(pid) = file
-            .strip_prefix(&prefix)
+            .strip_prefix('.')
+            .and_then(|f| f.rsplit_once(".tmp-"))
+            .filter(|(name, _)| names.iter().any(|n| n == name))
+            .map(|(_, pid)| pid)
             .filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
         else {
             continue;
@@ -163,12 +176,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
+    let result = write_synced(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

@@ -124,14 +124,7 @@ fn add_twice_query_and_values_equal_summary() {
     for doc in &docs {
         let (c, m) = (doc["campaign"].as_str().unwrap(), &doc["mean"]);
         let n = doc["mean_included"].as_array().unwrap().len();
-        let at = page.find(&format!(">{c}</td>")).unwrap_or_else(|| panic!("no row of {c}"));
-        let cells: Vec<&str> = page[at..]
-            .split("</tr>")
-            .next()
-            .unwrap()
-            .split("</td>")
-            .filter_map(|c| c.rsplit('>').next())
-            .collect();
+        let cells = row_cells(&page, c);
         let want = [
             n.to_string(),
             format!("{:.3}", m["r_plus"].as_f64().unwrap()),
@@ -275,16 +268,7 @@ fn a_campaign_from_a_corrected_manifest_is_said_and_shown_apart() {
     );
     let page = std::fs::read_to_string(arc.join("archive.html")).unwrap();
     for (sha, n) in [("aa", "2"), ("bb", "3")] {
-        let at = page
-            .find(&format!(">c-aa (manifest {sha}…)</td>"))
-            .unwrap_or_else(|| panic!("no row for {sha}"));
-        let cells: Vec<&str> = page[at..]
-            .split("</tr>")
-            .next()
-            .unwrap()
-            .split("</td>")
-            .filter_map(|c| c.rsplit('>').next())
-            .collect();
+        let cells = row_cells(&page, &format!("c-aa (manifest {sha}…)"));
         assert_eq!(cells[3], n, "{cells:?}");
     }
     // A re-add of the same manifest replaces, and is not such a case.
@@ -357,4 +341,17 @@ fn a_summary_without_the_manifest_hash_is_refused() {
 fn summary_numbers_are_read_exactly() {
     let v: serde_json::Value = serde_json::from_str(r#"{"a": 0.014936020564324741}"#).unwrap();
     assert_eq!(v["a"].as_f64(), Some("0.014936020564324741".parse::<f64>().unwrap()));
+}
+
+/// The cells' texts of the archive page's table row whose cell reads `label`, from
+/// that cell on.
+fn row_cells<'a>(page: &'a str, label: &str) -> Vec<&'a str> {
+    let at = page.find(&format!(">{label}</td>")).unwrap_or_else(|| panic!("no row of {label}"));
+    page[at..]
+        .split("</tr>")
+        .next()
+        .unwrap()
+        .split("</td>")
+        .filter_map(|c| c.rsplit('>').next())
+        .collect()
 }

@@ -308,6 +308,17 @@ fn demo_copy_with_log_named(dir: &Path, log_name: &str) {
     std::fs::write(dir.join("campaign.toml"), manifest).unwrap();
 }
 
+/// `rocklab reduce DIR --out DIR --no-plots`: (exit code, stderr).
+fn reduce_into_itself(camp: &Path) -> (i32, String) {
+    run(&[
+        "reduce".as_ref(),
+        camp.as_os_str(),
+        "--out".as_ref(),
+        camp.as_os_str(),
+        "--no-plots".as_ref(),
+    ])
+}
+
 /// Every file below `dir` with its bytes.
 fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     tree(dir).into_iter().map(|p| (p.clone(), std::fs::read(dir.join(&p)).unwrap())).collect()
@@ -322,13 +333,7 @@ fn reduce_into_its_own_folder_never_replaces_an_input() {
     let camp = root.path();
     demo_copy_with_log_named(camp, "table1.csv");
     let before = contents(camp);
-    let (code, stderr) = run(&[
-        "reduce".as_ref(),
-        camp.as_os_str(),
-        "--out".as_ref(),
-        camp.as_os_str(),
-        "--no-plots".as_ref(),
-    ]);
+    let (code, stderr) = reduce_into_itself(camp);
     assert_eq!(code, 2, "{stderr}");
     assert!(
         stderr.contains("output table1.csv:") && stderr.contains("is an input of this run"),
@@ -341,13 +346,7 @@ fn reduce_into_its_own_folder_never_replaces_an_input() {
     let camp = root.path();
     demo_copy_with_log_named(camp, "150_1.csv");
     let before = contents(camp);
-    let (code, stderr) = run(&[
-        "reduce".as_ref(),
-        camp.as_os_str(),
-        "--out".as_ref(),
-        camp.as_os_str(),
-        "--no-plots".as_ref(),
-    ]);
+    let (code, stderr) = reduce_into_itself(camp);
     assert_eq!(code, 0, "{stderr}");
     let after = contents(camp);
     for (p, bytes) in &before {

@@ -58,6 +58,31 @@ PRESETS = {
                ("H2_80_1", 80, 100), ("H2_70_1", 70, 200)],
         seed=18_2,
     ),
+    # The public campaigns' wall, bedding and transverse walls (their truth.json `sim`
+    # blocks: H 3.00 m, b 0.40 m, LVDT at 2.90 m; one-sided bedding time constant
+    # 2.9-3.3 ms, transverse walls K 1300-2400 s^-2; two-sided bedding 13.8-16.9 ms),
+    # drawn anew with other tests: the closest stand-in for campaigns made like the
+    # public ones that the estimator has never seen (session 14). The public blocks
+    # state damping ratios 0.14-0.20 in MuJoCo's (timeconst, dampratio) form, but that
+    # form with this geometry loses far more than the public tests do (P1_150_1
+    # replayed: v1 252 mm/s at 0.07, public 442); the direct form with 0.05-0.09
+    # gives the public's decay (P1_150_1 at 0.07: 428, -407, 282 against 442, -421,
+    # 279; P1_90_1 at 0.084: 338, -315, 208 against 312, -292, 173).
+    "public-like-one-sided": dict(
+        rocking="one-sided", H=3.00, b=0.40, w=2.00, density=1961.4, L=2.90,
+        bed_tc=(0.0028, 0.0034), bed_solimp=[0.05, 0.8, 0.0005, 0.5, 2.0],
+        K_in=(1300.0, 2400.0), zeta_in=(0.05, 0.09),
+        tests=[("Q1_170_1", 170, 200), ("Q1_160_1", 160, 500), ("Q1_150_1", 150, 1000),
+               ("Q1_140_1", 140, 200), ("Q1_155_1", 155, 100)],
+        seed=14_1,
+    ),
+    "public-like-two-sided": dict(
+        rocking="two-sided", H=3.00, b=0.40, w=2.00, density=1998.5, L=2.90,
+        bed_tc=(0.0135, 0.0170), bed_solimp=[0.1, 0.4, 0.001, 0.5, 2.0],
+        tests=[("Q2_150_1", 150, 200), ("Q2_130_1", 130, 1000), ("Q2_110_1", 110, 100),
+               ("Q2_90_1", 90, 500), ("Q2_70_1", 70, 200)],
+        seed=14_2,
+    ),
     # Generalisation checks of the per-impact readings (issue 20), never tuned on: a
     # slender tall wall on a medium bedding, two-sided, and a squat short wall with
     # soft, very lossy transverse walls, one-sided.

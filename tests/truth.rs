@@ -517,9 +517,9 @@ fn summary_of(name: &str, rep: &[(String, f64, bool, Vec<f64>)]) -> (usize, f64,
 /// ok ones within 0.58 pp (H2_110_2's residuals around impact 4 are vouched
 /// for by its local readings, `src/peaks/vouch.rs`); one-sided, 1 of 6
 /// flagged (H1_140_1, 1.66 pp off: the rule is two-sided only), the ok ones
-/// within 1.24 pp (the outward peaks v₁, v₃ 2–3.7 % low: the global fit's
-/// lossy-restraint arc against MuJoCo's restraint); 100 % (two-sided) and 97 %
-/// (one-sided) of the ok tests' peaks within 2 stated u.
+/// within 1.12 pp (H1_150_1, 100 Hz; 1.24 pp, H1_140_2, before the
+/// restraint's damping was started again: the outward peaks v₁, v₃ 2–3.7 %
+/// low); 100 % of the ok tests' peaks within 2 stated u on both.
 /// This test guards what holds (the two-sided campaign meets the issue's
 /// criterion: at most one test flagged, no ok test beyond 1.0 pp, ≥ 90 % of
 /// the peaks within 2 u; one-sided, at most one flagged and the coverage of
@@ -531,19 +531,25 @@ fn mujoco_holdouts_reduced_or_flagged() {
     assert!(flagged2 <= 1, "two-sided: {flagged2} tests flagged");
     assert!(worst2 <= 1.0, "two-sided: an ok test {worst2:.2} pp off");
     assert!(within2 >= 0.9, "two-sided: {within2:.2} of the peaks within 2 u");
-    let (flagged1, _, within1) = holdout_summary("mujoco-holdout-one-sided");
+    let rep1 = holdout_report("mujoco-holdout-one-sided");
+    let (flagged1, _, within1) = summary_of("mujoco-holdout-one-sided", &rep1);
     assert!(flagged1 <= 1, "one-sided: {flagged1} tests flagged");
     assert!(within1 >= 0.9, "one-sided: {within1:.2} of the peaks within 2 u");
+    // The restraint's damping started again (segments.rs, `restart_damping`):
+    // from γ = 0 the fit of H1_140_2 stopped at γ = 4.9 s⁻¹, 1.24 pp off (r₁);
+    // the lower minimum near γ = 9.3 s⁻¹ reads it within the issue's 1.0 pp.
+    let h = rep1.iter().find(|r| r.0 == "H1_140_2").expect("H1_140_2 in the hold-out");
+    assert!(h.2 && h.1 <= 1.0, "H1_140_2: ok {}, {:.2} pp off", h.2, h.1);
 }
 
 /// The issue's criterion on both hold-out campaigns: at most one test flagged
 /// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
 /// within 2 u. Fails today on the one-sided campaign (see
-/// `mujoco_holdouts_reduced_or_flagged`): r₁ = v₁/v₀ of H1_140_2, H1_150_1
-/// and H1_160_2, where the wall leaves the transverse walls (docs/accuracy.md,
+/// `mujoco_holdouts_reduced_or_flagged`): r₁ = v₁/v₀ of H1_150_1 (100 Hz),
+/// where the wall leaves the transverse walls (docs/accuracy.md,
 /// "One-sided: the exit from the inward side, and the restraint's amplitude").
 #[test]
-#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.24 pp"]
+#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.12 pp"]
 fn holdouts_meet_the_issue() {
     for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
         let (flagged, worst, within) = holdout_summary(name);

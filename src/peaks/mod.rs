@@ -483,6 +483,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         if let Some(alt) = &fit.alternative {
             uncertainty::add_model_spread(&mut c, &impacts, alt);
         }
+        if let Some(alt) = &fit.rival_minimum {
+            uncertainty::add_model_spread(&mut c, &impacts, alt);
+        }
         uncertainty::add_zero_spread(&mut c, &spread);
         if let Some((est, cutoff)) = &fit.estimated {
             acquisition::add_cutoff_spread(&mut c, cutoff);

@@ -43,6 +43,9 @@ pub struct SegmentFit {
     /// The peaks of the instantaneous-impact model where contact phases were
     /// chosen (the model-form spread).
     pub alternative: Option<Vec<f64>>,
+    /// The peaks of another minimum of the one-sided contact fit that the data
+    /// do not reject ([`restart_damping`]): a model-form spread carried into u.
+    pub rival_minimum: Option<Vec<f64>>,
     /// An unstated filter found and estimated, and the peaks of the fits at its
     /// cut-off ± one standard uncertainty (the spread carried into u).
     pub estimated: Option<(super::acquisition::Estimate, Vec<Vec<f64>>)>,
@@ -150,6 +153,12 @@ impl SegmentFit {
         if let Some((e, _)) = &estimated {
             (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
         }
+        // One-sided contact fits start from an undamped restraint (γ = 0); a
+        // restraint with its damping can sit in a second, lower minimum.
+        let mut rival_minimum = None;
+        if one_sided && contacts {
+            (chosen, rival_minimum) = restart_damping(chosen, &tw, &yw, extra * n.ln() * sigma2);
+        }
         Ok(SegmentFit {
             rms: (chosen.fit.cost / n).sqrt(),
             fitted: chosen,
@@ -160,6 +169,7 @@ impl SegmentFit {
             contacts,
             outliers,
             alternative,
+            rival_minimum,
             estimated,
             filter_dropped,
         })
@@ -292,6 +302,67 @@ fn misses_around_impacts(model: &Model, tw: &[f64], yw: &[f64], dt: f64, sigma: 
     }
     let rms = (near.iter().map(|v| v * v).sum::<f64>() / near.len() as f64).sqrt();
     rms > 1.2 * sigma
+}
+
+/// Restraint decay rates γ (s⁻¹) from which a one-sided contact fit is
+/// started again ([`restart_damping`]): damping ratios γ/√λ of about 0.06 to
+/// 0.4 at the λ = 1300–3000 s⁻² that the engine's one-sided logs fit.
+const RESTART_GAMMAS: [f64; 4] = [3.0, 6.0, 10.0, 15.0];
+
+/// The one-sided contact fit `f` started again from each of
+/// [`RESTART_GAMMAS`]. The lowest cost replaces the first fit where it is
+/// lower by more than `evidence` (what the fit demands before it adds contact
+/// phases, 6 σ² ln n); otherwise the first fit stays. Returned with it: the
+/// peaks of the minimum that differs most from it among those whose cost is
+/// within `evidence` of it, if any (the data cannot choose between the two, and
+/// their spread is a model-form term of u).
+///
+/// Every one-sided start begins with an undamped restraint (γ = 0; the starts
+/// differ in λ only, [`best_simple_fit`]), and the cost has more than one
+/// minimum. On the public-like MuJoCo stand-ins 8 of 20 tests stopped at
+/// γ = 2–5 s⁻¹ with r₁ 0.9–1.25 pp low and r⁻ 0.9 pp high; started again
+/// from 6 or 10 s⁻¹ six of them found γ = 9–10 s⁻¹ at a cost lower by
+/// hundreds of σ², and their values within 0.4–0.8 pp (docs/accuracy.md,
+/// "One-sided: the restraint's damping, started again"). On the compliant
+/// random draw (seed 1064003192, 100 Hz) a restart reached a minimum 12 σ²
+/// lower with the same γ but other contact shapes, whose odd peaks were 2–7 %
+/// off at u 0.9 mm/s (the first fit's within 2.2 %): it is not taken, and its
+/// spread widens the first fit's u. Run after the
+/// logger filter's rivalry, so that a lower contact cost cannot displace an
+/// estimated filter (on the unstated-Bessel draw, run before it, it let a
+/// 100 Hz test through 2.04 pp off with status ok).
+fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted, Option<Vec<f64>>) {
+    let mut fits = vec![f];
+    for g in RESTART_GAMMAS {
+        let mut mdl = fits[0].model.clone();
+        mdl.q[ix::GAMMA] = g;
+        if let Some(c) = fit_model(mdl, tw, yw, 100) {
+            fits.push(c);
+        }
+    }
+    let lowest = (0..fits.len())
+        .min_by(|&a, &b| fits[a].fit.cost.total_cmp(&fits[b].fit.cost))
+        .unwrap_or(0);
+    // Another minimum replaces the first fit only where the data prefer it by
+    // the evidence; otherwise the first fit stays and the other widens u.
+    let chosen = if fits[0].fit.cost - fits[lowest].fit.cost > evidence {
+        lowest
+    } else {
+        0
+    };
+    let best = fits.swap_remove(chosen);
+    let m = best.model.m();
+    let peaks = |f: &Fitted| (0..m).map(|k| f.model.peak(k).1).collect::<Vec<f64>>();
+    let mine = peaks(&best);
+    let rival = fits
+        .iter()
+        .filter(|f| f.fit.cost - best.fit.cost <= evidence)
+        .map(peaks)
+        .map(|p| (p.iter().zip(&mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
+        .filter(|(d, _)| d.is_finite() && *d > 0.0)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, p)| p);
+    (best, rival)
 }
 
 /// Starting values from the geometry and the crossings.

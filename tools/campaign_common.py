@@ -119,3 +119,30 @@ def write_campaign(p, out, how, rng, simulate, engine, script, toml_header):
                  tests=tests)
     with open(os.path.join(out, "truth.json"), "w") as f:
         json.dump(truth, f, indent=1)
+
+
+def stored_test(out, tid):
+    """Test `tid`'s entry in the truth.json of the campaign in `out`."""
+    truth = json.load(open(os.path.join(out, "truth.json")))
+    return next(x for x in truth["tests"] if x["id"] == tid)
+
+
+def write_trace(a, t_rel, test, trace):
+    """Check that a re-simulated test's peaks are truth.json's, then write its trajectory.
+
+    a: the trajectory (rows as `truth_peaks` reads them); test: its truth.json entry.
+    Writes time_s (on the log's time axis), x_mm (sensor point, rest subtracted),
+    v_mm_s, theta_rad at every recorded step.
+    """
+    tid, sim = test["id"], test["sim"]
+    peaks, _ = truth_peaks(a, t_rel)
+    got = [q["velocity_mm_s"] for q in peaks[:6]]
+    want = [q["velocity_mm_s"] for q in test["peaks"][:6]]
+    if max(abs(g - w) for g, w in zip(got, want)) > 1e-3:
+        raise SystemExit(f"{tid}: peaks {got} differ from truth.json's {want}: another preset or engine?")
+    shift = t_rel - sim["t_release_s"]
+    with open(trace, "w") as f:
+        f.write("time_s x_mm v_mm_s theta_rad\n")
+        for row in a:
+            f.write(f"{row[0] - shift:.6f} {1000.0 * (row[1] - a[-1, 1]):.5f} {1000.0 * row[2]:.4f} {row[3]:.8f}\n")
+    print(f"{tid}: peaks as in truth.json; {len(a)} steps written to {trace}")

@@ -34,14 +34,12 @@ and 0.01 mm quantisation, sampled at fs with a random phase. The truth, the tabl
 tools/campaign_common.py's, shared with tools/penalty_campaign.py (a second engine).
 """
 import argparse
-import json
 import math
-import os
 
 import mujoco
 import numpy as np
 
-from campaign_common import truth_peaks, write_campaign
+from campaign_common import stored_test, write_campaign, write_trace
 
 PRESETS = {
     # A slenderer wall than the public campaigns, stiff bedding, lossy transverse walls.
@@ -234,21 +232,10 @@ class Replay:
 
 def resimulate(p, out, tid, trace):
     """Run test `tid` of the campaign in `out` again (module docs) and write its trajectory."""
-    truth = json.load(open(os.path.join(out, "truth.json")))
-    test = next(x for x in truth["tests"] if x["id"] == tid)
+    test = stored_test(out, tid)
     sim = test["sim"]
     a, _, t_rel, _ = simulate(p, sim["x0_mm_nominal"], Replay(sim))
-    peaks, _ = truth_peaks(a, t_rel)
-    got = [q["velocity_mm_s"] for q in peaks[:6]]
-    want = [q["velocity_mm_s"] for q in test["peaks"][:6]]
-    if max(abs(g - w) for g, w in zip(got, want)) > 1e-3:
-        raise SystemExit(f"{tid}: peaks {got} differ from truth.json's {want}: another preset or engine?")
-    shift = t_rel - sim["t_release_s"]
-    with open(trace, "w") as f:
-        f.write("time_s x_mm v_mm_s theta_rad\n")
-        for row in a:
-            f.write(f"{row[0] - shift:.6f} {1000.0 * (row[1] - a[-1, 1]):.5f} {1000.0 * row[2]:.4f} {row[3]:.8f}\n")
-    print(f"{tid}: peaks as in truth.json; {len(a)} steps written to {trace}")
+    write_trace(a, t_rel, test, trace)
 
 
 def main():

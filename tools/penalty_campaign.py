@@ -33,6 +33,14 @@ holdout_law_from_readings read it unchanged. numpy only (pure-Python stepping: a
     python3 tools/penalty_campaign.py --preset penalty-two-sided --seed 1 --out /tmp/pen2-s1
     python3 tools/penalty_campaign.py --preset penalty-one-sided --seed 1 --out /tmp/pen1-s1
     python3 tools/penalty_campaign.py --check
+
+`--resimulate TEST --trace FILE` runs one test of the campaign in `--out` again from the
+draws stored in its truth.json `sim` block (the preset must be the one that made it),
+checks its peaks against truth.json and writes the trajectory every 0.1 ms on the log's
+time axis (time_s, x_mm, v_mm_s, theta_rad), as mujoco_campaign.py's does:
+
+    python3 tools/penalty_campaign.py --preset penalty-one-sided --out /tmp/pen1-s3 \
+        --resimulate E1_140_1 --trace /tmp/E1_140_1.txt
 """
 import argparse
 import math
@@ -40,7 +48,7 @@ import sys
 
 import numpy as np
 
-from campaign_common import truth_peaks, write_campaign
+from campaign_common import stored_test, truth_peaks, write_campaign, write_trace
 
 G = 9.81
 DT = 1e-5
@@ -227,6 +235,16 @@ def simulate(p, x0_mm, rng):
     return a, theta0, t_rel, q
 
 
+def resimulate(p, out, tid, trace):
+    """Run test `tid` of the campaign in `out` again from its `sim` block's draws and
+    write its trajectory (as mujoco_campaign.py's --resimulate)."""
+    test = stored_test(out, tid)
+    sim = test["sim"]
+    q = {k: sim[k] for k in draw(p, np.random.default_rng(0))}
+    a = run(model(p, q), sim["theta0_rad"], 1.0, 30.0)
+    write_trace(a, 1.0, test, trace)
+
+
 def first_contact(a, t_rel):
     """Duration of the first impact: from the inward toe's touch-down (the higher toe
     reaching the bedding after the release) to the first crossing of theta = 0 after
@@ -296,9 +314,15 @@ def main():
                     help="seed of the random draws (default: the preset's): other beddings, "
                          "restraints, noise and drift for the same wall and tests")
     ap.add_argument("--check", action="store_true", help="the engine's checks (energy, e_H, time step)")
+    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
+    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
     args = ap.parse_args()
     if args.check:
         return check()
+    if args.resimulate:
+        if not (args.preset and args.out and args.trace):
+            sys.exit("--resimulate needs --preset, --out and --trace FILE")
+        return resimulate(PRESETS[args.preset], args.out, args.resimulate, args.trace)
     if not args.preset or not args.out:
         sys.exit("--preset and --out, or --check")
     p = PRESETS[args.preset]

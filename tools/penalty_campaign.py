@@ -79,12 +79,12 @@ PRESETS = {
         seed=14_11,
     ),
 }
-# Diagnostic variants (docs/accuracy.md, "A second engine: penalty contacts"): the
-# two-sided wall on its two toes only, and the one-sided wall with linear transverse
-# walls (m = 1). The first test's draws are the preset's; later tests' differ, as the
+# Diagnostic variants (docs/accuracy.md, "A second engine: penalty contacts"): each
+# wall on its two toes only, and the one-sided wall with linear transverse walls (m = 1). The first test's draws are the preset's; later tests' differ, as the
 # logger's noise draws depend on the length of the trajectory before them.
 PRESETS["penalty-two-sided-toes"] = dict(PRESETS["penalty-two-sided"], base_points=2, seed=14_23)
 PRESETS["penalty-one-sided-linear"] = dict(PRESETS["penalty-one-sided"], m_r=(1.0, 1.0), seed=14_13)
+PRESETS["penalty-one-sided-toes"] = dict(PRESETS["penalty-one-sided"], base_points=2, seed=14_14)
 D_REF = 5e-3  # m: the restraint's k_r is its secant stiffness at this penetration
 
 

@@ -10,6 +10,7 @@ drift, 0.01 mm quantisation, sampled at fs) and the files (campaign.toml, one CS
 test, truth.json), in the format the Rust tests read (tests/truth.rs,
 tests/local_readings.rs, tests/law.rs).
 """
+import argparse
 import json
 import math
 import os
@@ -146,3 +147,33 @@ def write_trace(a, t_rel, test, trace):
         for row in a:
             f.write(f"{row[0] - shift:.6f} {1000.0 * (row[1] - a[-1, 1]):.5f} {1000.0 * row[2]:.4f} {row[3]:.8f}\n")
     print(f"{tid}: peaks as in truth.json; {len(a)} steps written to {trace}")
+
+
+def cli(presets, make, resimulate, check=None):
+    """The engine scripts' command line: --preset/--out [--seed] makes a campaign with
+    make(preset, out, how, rng); --resimulate TEST --trace FILE runs
+    resimulate(preset, out, TEST, FILE); --check (where the script has one) runs check()."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--preset", required=check is None, choices=sorted(presets))
+    ap.add_argument("--out", required=check is None)
+    ap.add_argument("--seed", type=int, default=None,
+                    help="seed of the random draws (default: the preset's); another seed draws "
+                         "other beddings, restraints, noise and drift for the same wall and tests")
+    if check is not None:
+        ap.add_argument("--check", action="store_true", help="the engine's own checks")
+    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
+    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
+    args = ap.parse_args()
+    if check is not None and args.check:
+        return check()
+    if not args.preset or not args.out:
+        raise SystemExit("--preset and --out, or --check")
+    p = presets[args.preset]
+    if args.resimulate:
+        if not args.trace:
+            raise SystemExit("--resimulate needs --trace FILE")
+        return resimulate(p, args.out, args.resimulate, args.trace)
+    seed = p["seed"] if args.seed is None else args.seed
+    rng = np.random.default_rng(seed)
+    how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")
+    make(p, args.out, how, rng)

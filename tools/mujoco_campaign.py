@@ -33,13 +33,12 @@ The sensor reads the horizontal displacement of a point of the outward face at h
 and 0.01 mm quantisation, sampled at fs with a random phase. The truth, the tables, the logger and the files are
 tools/campaign_common.py's, shared with tools/penalty_campaign.py (a second engine).
 """
-import argparse
 import math
 
 import mujoco
 import numpy as np
 
-from campaign_common import stored_test, write_campaign, write_trace
+from campaign_common import cli, stored_test, write_campaign, write_trace
 
 PRESETS = {
     # A slenderer wall than the public campaigns, stiff bedding, lossy transverse walls.
@@ -238,29 +237,12 @@ def resimulate(p, out, tid, trace):
     write_trace(a, t_rel, test, trace)
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--preset", required=True, choices=sorted(PRESETS))
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--seed", type=int, default=None,
-                    help="seed of the random draws (default: the preset's); another seed draws "
-                         "other beddings, restraints, noise and drift for the same wall and tests")
-    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
-    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
-    args = ap.parse_args()
-    p = PRESETS[args.preset]
-    if args.resimulate:
-        if not args.trace:
-            raise SystemExit("--resimulate needs --trace FILE")
-        return resimulate(p, args.out, args.resimulate, args.trace)
-    seed = p["seed"] if args.seed is None else args.seed
-    rng = np.random.default_rng(seed)
-    how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")
+def make(p, out, how, rng):
     header = [f"# Hold-out campaign made with MuJoCo {mujoco.__version__} by tools/mujoco_campaign.py {how}",
               "# (rigid wall, compliant finite-duration contacts); truth in truth.json."]
-    write_campaign(p, args.out, how, rng, simulate, dict(engine=f"MuJoCo {mujoco.__version__}", timestep_s=DT),
+    write_campaign(p, out, how, rng, simulate, dict(engine=f"MuJoCo {mujoco.__version__}", timestep_s=DT),
                    "tools/mujoco_campaign.py", header)
 
 
 if __name__ == "__main__":
-    main()
+    cli(PRESETS, make, resimulate)

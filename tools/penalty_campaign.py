@@ -42,13 +42,11 @@ time axis (time_s, x_mm, v_mm_s, theta_rad), as mujoco_campaign.py's does:
     python3 tools/penalty_campaign.py --preset penalty-one-sided --out /tmp/pen1-s3 \
         --resimulate E1_140_1 --trace /tmp/E1_140_1.txt
 """
-import argparse
 import math
-import sys
 
 import numpy as np
 
-from campaign_common import stored_test, truth_peaks, write_campaign, write_trace
+from campaign_common import cli, stored_test, truth_peaks, write_campaign, write_trace
 
 G = 9.81
 DT = 1e-5
@@ -312,34 +310,12 @@ def check():
               f"{[round(float(v), 1) for v in out[1]]}: largest difference {100 * rel:.3f} %")
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--preset", choices=sorted(PRESETS))
-    ap.add_argument("--out")
-    ap.add_argument("--seed", type=int, default=None,
-                    help="seed of the random draws (default: the preset's): other beddings, "
-                         "restraints, noise and drift for the same wall and tests")
-    ap.add_argument("--check", action="store_true", help="the engine's checks (energy, e_H, time step)")
-    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
-    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
-    args = ap.parse_args()
-    if args.check:
-        return check()
-    if args.resimulate:
-        if not (args.preset and args.out and args.trace):
-            sys.exit("--resimulate needs --preset, --out and --trace FILE")
-        return resimulate(PRESETS[args.preset], args.out, args.resimulate, args.trace)
-    if not args.preset or not args.out:
-        sys.exit("--preset and --out, or --check")
-    p = PRESETS[args.preset]
-    seed = p["seed"] if args.seed is None else args.seed
-    rng = np.random.default_rng(seed)
-    how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")
+def make(p, out, how, rng):
     header = [f"# Check campaign made with penalty contacts by tools/penalty_campaign.py {how}",
-              "# (rigid wall, Hunt-Crossley bedding at the toes, penalty transverse walls); truth in truth.json."]
-    write_campaign(p, args.out, how, rng, simulate, dict(engine="penalty contacts (tools/penalty_campaign.py)", timestep_s=DT),
+              "# (rigid wall, Hunt-Crossley bedding at points of the base, penalty transverse walls); truth in truth.json."]
+    write_campaign(p, out, how, rng, simulate, dict(engine="penalty contacts (tools/penalty_campaign.py)", timestep_s=DT),
                    "tools/penalty_campaign.py", header)
 
 
 if __name__ == "__main__":
-    main()
+    cli(PRESETS, make, resimulate, check)

@@ -30,15 +30,15 @@ half-cycle k (between zero crossings k-1 and k of theta), from the engine's stat
 every 0.1 ms step; the table values are computed from those peaks (paper Eqs. 3-6).
 The sensor reads the horizontal displacement of a point of the outward face at height L
 (L sin theta plus the bedding's own small motion), plus Gaussian noise, a linear drift
-and 0.01 mm quantisation, sampled at fs with a random phase.
+and 0.01 mm quantisation, sampled at fs with a random phase. The truth, the tables, the logger and the files are
+tools/campaign_common.py's, shared with tools/penalty_campaign.py (a second engine).
 """
-import argparse
-import json
 import math
-import os
 
 import mujoco
 import numpy as np
+
+from campaign_common import cli, stored_test, write_campaign, write_trace
 
 PRESETS = {
     # A slenderer wall than the public campaigns, stiff bedding, lossy transverse walls.
@@ -217,36 +217,6 @@ def simulate(p, x0_mm, rng):
     return a, theta0, t_rel, sim
 
 
-def truth_peaks(a, t_rel, rocking):
-    t, v, th = a[:, 0], a[:, 2], a[:, 3]  # noqa: E741
-    i0 = np.searchsorted(t, t_rel)
-    cross = []
-    for i in range(i0 + 1, len(t)):
-        if th[i - 1] * th[i] < 0 or (th[i] == 0 and th[i - 1] != 0):
-            cross.append(i)
-    peaks = []
-    start = i0
-    for k, ic in enumerate(cross[:12]):
-        seg = slice(start, ic + 1)
-        want = -1.0 if k % 2 == 0 else 1.0
-        j = start + int(np.argmax(want * v[seg]))
-        lifted = float(np.mean(a[seg, 4] > 0.0))
-        peaks.append(dict(k=k, i=j, velocity_mm_s=1000.0 * v[j], lift_fraction=lifted))
-        start = ic
-    return peaks, [t[i] for i in cross[:12]]
-
-
-def tables(v, e_h):
-    loc = [abs(v[k + 1] / v[k]) for k in range(5)]
-    ss = lambda k: math.sqrt(abs(v[k + 2] / v[k]))
-    e = sum(loc) / 5
-    e_minus = 0.5 * (ss(0) + ss(2))
-    e_plus = 0.5 * (ss(1) + ss(3))
-    return dict(e=e, e_plus=e_plus, e_minus=e_minus, r=e / e_h, r_plus=e_plus / e_h,
-                r_minus=e_minus / e_h, r1=loc[0] / e_h, r1_plus=ss(1) / e_h, r1_minus=ss(0) / e_h,
-                r2=0.5 * (loc[0] + loc[1]) / e_h)
-
-
 class Replay:
     """The stored draws of a test's `sim` block, handed out in the order `build` draws them."""
 
@@ -261,105 +231,18 @@ class Replay:
 
 def resimulate(p, out, tid, trace):
     """Run test `tid` of the campaign in `out` again (module docs) and write its trajectory."""
-    truth = json.load(open(os.path.join(out, "truth.json")))
-    test = next(x for x in truth["tests"] if x["id"] == tid)
+    test = stored_test(out, tid)
     sim = test["sim"]
     a, _, t_rel, _ = simulate(p, sim["x0_mm_nominal"], Replay(sim))
-    peaks, _ = truth_peaks(a, t_rel, p["rocking"])
-    got = [q["velocity_mm_s"] for q in peaks[:6]]
-    want = [q["velocity_mm_s"] for q in test["peaks"][:6]]
-    if max(abs(g - w) for g, w in zip(got, want)) > 1e-3:
-        raise SystemExit(f"{tid}: peaks {got} differ from truth.json's {want}: another preset or engine?")
-    shift = t_rel - sim["t_release_s"]
-    with open(trace, "w") as f:
-        f.write("time_s x_mm v_mm_s theta_rad\n")
-        for row in a:
-            f.write(f"{row[0] - shift:.6f} {1000.0 * (row[1] - a[-1, 1]):.5f} {1000.0 * row[2]:.4f} {row[3]:.8f}\n")
-    print(f"{tid}: peaks as in truth.json; {len(a)} steps written to {trace}")
+    write_trace(a, t_rel, test, trace)
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--preset", required=True, choices=sorted(PRESETS))
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--seed", type=int, default=None,
-                    help="seed of the random draws (default: the preset's); another seed draws "
-                         "other beddings, restraints, noise and drift for the same wall and tests")
-    ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
-    ap.add_argument("--trace", help="where --resimulate writes the trajectory")
-    args = ap.parse_args()
-    p = PRESETS[args.preset]
-    if args.resimulate:
-        if not args.trace:
-            raise SystemExit("--resimulate needs --trace FILE")
-        return resimulate(p, args.out, args.resimulate, args.trace)
-    seed = p["seed"] if args.seed is None else args.seed
-    rng = np.random.default_rng(seed)
-    how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")
-    os.makedirs(args.out, exist_ok=True)
-    name = os.path.basename(os.path.normpath(args.out))
-    H, b = p["H"], p["b"]
-    alpha = math.atan(b / H)
-    e_h = 1 - 1.5 * math.sin(alpha) ** 2
-    mass = p["density"] * H * b * p["w"]
-    toml = [f"# Hold-out campaign made with MuJoCo {mujoco.__version__} by tools/mujoco_campaign.py {how}",
-            "# (rigid wall, compliant finite-duration contacts); truth in truth.json.", "",
-            "[campaign]", f'name = "{name}"', f'rocking = "{p["rocking"]}"', "", "[wall]",
-            f"height_m = {H:.2f}", f"thickness_m = {b:.2f}", f"width_m = {p['w']:.2f}",
-            f"weight_kN = {mass * 9.81 / 1000:.1f}", "hinge_height_m = 0.00", "", "[channels]",
-            'time = { column = "time_s", unit = "s" }',
-            f'displacement = {{ column = "disp_mm", unit = "mm", height_m = {p["L"]:.2f} }}',
-            "outward_sign = 1", "", "[format]", 'delimiter = ","', 'decimal = "."']
-    tests = []
-    for tid, x0, fs in p["tests"]:
-        a, theta0, t_rel, sim = simulate(p, x0, rng)
-        peaks, cross = truth_peaks(a, t_rel, p["rocking"])
-        # As the public campaigns: a test is only made if its wall still rocks (one
-        # edge off the bedding for most of each half-cycle) through the six peaks the
-        # tables use; below that the "half-cycles" are the bedding's own wobble.
-        lift = [q["lift_fraction"] for q in peaks]
-        if len(peaks) < 6 or min(lift[:6]) < 0.5:
-            raise SystemExit(f"{tid}: the wall stops rocking before peak 6 (lift fractions {lift})")
-        # Logger: a random phase, from 1 s before the release to 3 s after the motion ends.
-        sigma = rng.uniform(0.01, 0.04)
-        drift = rng.uniform(-0.2, 0.2)
-        t_start = t_rel - 1.0 + rng.uniform(0, 1 / fs)
-        t_end = min(a[-1, 0], cross[-1] + 3.0)
-        ts = np.arange(t_start, t_end, 1 / fs)
-        x_rest = a[-1, 1]
-        xs = np.interp(ts, a[:, 0], a[:, 1]) - x_rest
-        xs = 1000.0 * xs
-        xs += rng.normal(0, sigma, len(ts)) + drift * (ts - ts[0]) / (ts[-1] - ts[0])
-        xs = np.round(xs / 0.01) * 0.01
-        t_file = ts - ts[0]
-        with open(os.path.join(args.out, f"{tid}.csv"), "w") as f:
-            f.write(f"# campaign: {name}\n# test: {tid}\n# sampling_rate_Hz: {fs}\n")
-            f.write(f"# channels: time_s [s]; disp_mm [mm] LVDT at {p['L']:.2f} m, positive = outward\n")
-            f.write("time_s,disp_mm\n")
-            for ti, xi in zip(t_file, xs):
-                f.write(f"{ti:.6f},{xi:.2f}\n")
-        pk = [dict(k=q["k"], time_s=a[q["i"], 0] - ts[0], velocity_mm_s=q["velocity_mm_s"]) for q in peaks]
-        v = [q["velocity_mm_s"] for q in pk]
-        tab = tables(v, e_h)
-        sim.update(engine=f"MuJoCo {mujoco.__version__}", timestep_s=DT, fs_Hz=fs, sigma_mm=sigma, drift_mm=drift,
-                   quant_mm=0.01, x0_mm_nominal=x0, theta0_rad=theta0, t_release_s=t_rel - ts[0],
-                   zero_crossings_s=[c - ts[0] for c in cross], rocking_mass_kg=mass,
-                   lift_fraction_per_half_cycle=lift)
-        tests.append(dict(id=tid, file=f"{tid}.csv", exclude_from_mean=False, sim=sim, peaks=pk,
-                          **{k: tab[k] for k in ("r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2")},
-                          e=tab["e"], e_plus=tab["e_plus"], e_minus=tab["e_minus"]))
-        toml += ["", "[[test]]", f'id = "{tid}"', f'file = "{tid}.csv"', f"imposed_displacement_mm = {x0}",
-                 "exclude_from_mean = false"]
-        print(tid, fs, " ".join(f"{x:.1f}" for x in v[:8]), {k: round(tab[k], 4) for k in ("r", "r1")})
-    with open(os.path.join(args.out, "campaign.toml"), "w") as f:
-        f.write("\n".join(toml) + "\n")
-    truth = dict(campaign=name, rocking=p["rocking"], generator=f"MuJoCo {mujoco.__version__}, tools/mujoco_campaign.py {how}",
-                 conventions="as mujoco-public-*: peaks[k] = extreme of the sensor's horizontal velocity within half-cycle k (mm/s, outward positive); r.. divided by e_H",
-                 alpha_rad=alpha, e_housner=e_h, e_H=e_h, wall=dict(height_m=H, thickness_m=b, width_m=p["w"], sensor_height_m=p["L"]),
-                 tests=tests)
-    with open(os.path.join(args.out, "truth.json"), "w") as f:
-        json.dump(truth, f, indent=1)
+def make(p, out, how, rng):
+    header = [f"# Hold-out campaign made with MuJoCo {mujoco.__version__} by tools/mujoco_campaign.py {how}",
+              "# (rigid wall, compliant finite-duration contacts); truth in truth.json."]
+    write_campaign(p, out, how, rng, simulate, dict(engine=f"MuJoCo {mujoco.__version__}", timestep_s=DT),
+                   "tools/mujoco_campaign.py", header)
 
 
 if __name__ == "__main__":
-    main()
+    cli(PRESETS, make, resimulate)

@@ -216,7 +216,10 @@ fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, La
 /// [`ContactModel::Expected`], and the new analysis is kept if it has contact
 /// phases and status ok; a warning says so. On the one-sided MuJoCo campaign this
 /// moves the 200 Hz test P1_150_1 from 1.15 pp to within 0.52 pp of the truth
-/// (three of its four tests show their contacts).
+/// (three of its four tests show their contacts). A test whose filter was only
+/// estimated is read again with contact phases and no filter; where that
+/// reading fails its checks too, the test keeps its own reading and is suspect
+/// ([`neither_reading`]).
 fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests: Vec<TestOutcome>) -> Vec<TestOutcome> {
     if options.method != Method::Segments || options.contacts == ContactModel::Expected {
         return tests;
@@ -263,7 +266,42 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
             t.warnings.push(format!(
                 "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests with status ok show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
             ));
+            continue;
+        }
+        // Neither reading is vouched for: the campaign says the rounding is the
+        // wall's contacts, whose reading fails its checks, and the filter was
+        // only estimated from the rounding that the contacts explain.
+        let contacts_peaks = again.result.as_ref().ok().map(|n| n.analysis.peaks.as_slice());
+        let why = neither_reading(&r.analysis, contacts_peaks, with, n_ok);
+        if let Ok(r) = &mut t.result {
+            r.analysis.quality = std::mem::replace(&mut r.analysis.quality, crate::peaks::Quality::Ok).with(Some(why));
+            // A suspect test keeps its own analysis' impacts (resolve_impacts).
+            crate::reduction::resolve_impacts(r, &physics(campaign, &t.spec), campaign.e_housner, campaign.alpha_rad, options);
         }
     }
     tests
+}
+
+/// The reason of a test whose logger filter was only estimated while its
+/// campaign shows contact phases (`with` of its `n_ok` tests with status ok),
+/// and whose reading with contact phases and no filter (`contacts`, its peaks
+/// if it gave any) fails its checks (docs/estimator.md, "A contact is not a
+/// filter").
+fn neither_reading(filtered: &crate::peaks::Analysis, contacts: Option<&[crate::peaks::Peak]>, with: usize, n_ok: usize) -> String {
+    let filter = match (filtered.response.filter, filtered.response.fir_cutoff_hz) {
+        (Some(f), _) => f.describe(),
+        (None, Some(fc)) => format!("linear-phase FIR, cut-off {fc:.3} Hz"),
+        _ => filtered.response.source.to_string(),
+    };
+    let differ = contacts.map_or(String::new(), |c| {
+        let ratio = |p: &[crate::peaks::Peak], k: usize| p[k + 1].velocity_mm_s / p[k].velocity_mm_s;
+        let n = filtered.peaks.len().min(c.len());
+        let worst = (0..n.saturating_sub(1))
+            .map(|k| (ratio(&filtered.peaks, k) - ratio(c, k)).abs())
+            .fold(0.0, f64::max);
+        format!(" (the two readings' ratios of consecutive peaks differ by up to {worst:.3})")
+    });
+    format!(
+        "the logger's filter is not stated and the log cannot tell whether its impacts are rounded by a filter (estimated: {filter}) or by the wall's compliant contacts, as {with} of the campaign's {n_ok} tests with status ok show, and read with contact phases and no filter this test fails its checks, as it does with filter = \"none\" stated{differ}: state the filter (\"none\" if the logger has none)"
+    )
 }

@@ -34,6 +34,20 @@
 //! - the shape's (model form): the reading of the other shape on the same
 //!   window differs by d_s: u² = d_s²/3.
 //!
+//! The shape's term is one choice for the whole test (one bedding: its
+//! contacts turn the velocity over at a corner or smoothly at every impact), so
+//! it is shared by the test's peaks: the covariance of the peaks read locally
+//! takes it as one rank-one term D Dᵀ/3, D_k the smooth reading of peak k minus
+//! its corner reading (the truth anywhere between the two readings, alike for
+//! every peak), as the global fit's model spreads are
+//! ([`super::uncertainty::add_model_spread`]); the fit's and the window's
+//! terms stay per peak. Each peak's u is unchanged; a ratio of two peaks keeps
+//! only the part of the shape's term that differs between them. On the
+//! public-like stand-in Q2-s5, Q2_90_1 (500 Hz) read its peaks by corners with
+//! d_s = 30–34 mm/s (the quartic does not fit the corner's 103-sample window),
+//! u 3.6–7.3 % of each peak against errors of 0.0–1.9 %, and with the shape's
+//! term independent per peak r₁ came out ± 5.0 pp and the test was suspect.
+//!
 //! # The choice, per impact and per test
 //! A peak is resolved where:
 //! - the smooth window holds at least 9 samples (h ≥ 4 samples);
@@ -81,8 +95,12 @@ pub enum ReadingMethod {
 pub struct LocalReading {
     pub time_s: f64,
     pub velocity_mm_s: f64,
-    /// Standard uncertainty (fit and window terms), mm/s.
+    /// Standard uncertainty (fit, window and shape terms), mm/s.
     pub u_mm_s: f64,
+    /// The smooth shape's reading minus the corner's on the same window
+    /// (signed, mm/s): the shape's term of u is |this|/√3, shared by the
+    /// test's peaks (module docs).
+    pub smooth_minus_corner_mm_s: f64,
     /// Half-width of the smooth window, in samples.
     pub half_width: usize,
 }
@@ -311,6 +329,7 @@ pub fn read(t: &[f64], y: &[f64], t_peak: f64, want: f64, dt: f64, max_half: usi
         time_s: time,
         velocity_mm_s: v,
         u_mm_s: (u_fit * u_fit + (d_w * d_w + d_s * d_s) / 3.0).sqrt(),
+        smooth_minus_corner_mm_s: if q.shape == Shape::Smooth { -d_s } else { d_s },
         half_width: n,
     })
 }
@@ -348,7 +367,7 @@ pub(super) fn choose(
         return vec![ReadingMethod::KinkModel; peaks.len()];
     }
     let mut cov = cov;
-    readings
+    let methods = readings
         .iter()
         .enumerate()
         .map(|(k, r)| {
@@ -368,7 +387,20 @@ pub(super) fn choose(
             }
             ReadingMethod::LocalExtreme
         })
-        .collect()
+        .collect();
+    // The shape's term, shared by the test's peaks (module docs): the rest
+    // of D Dᵀ/3 (its diagonal is in each u already).
+    if let Some(c) = cov {
+        let d: Vec<f64> = readings.iter().map(|r| r.map_or(0.0, |r| r.smooth_minus_corner_mm_s)).collect();
+        for (j, dj) in d.iter().enumerate() {
+            for (k, dk) in d.iter().enumerate() {
+                if j != k {
+                    c[j][k] += dj * dk / 3.0;
+                }
+            }
+        }
+    }
+    methods
 }
 
 #[cfg(test)]

@@ -319,10 +319,11 @@ const RESTART_GAMMAS: [f64; 4] = [3.0, 6.0, 10.0, 15.0];
 ///
 /// Every one-sided start begins with an undamped restraint (γ = 0; the starts
 /// differ in λ only, [`best_simple_fit`]), and the cost has more than one
-/// minimum. On the public-like MuJoCo stand-ins 8 of 20 tests stopped at
-/// γ = 2–5 s⁻¹ with r₁ 0.9–1.25 pp low and r⁻ 0.9 pp high; started again
-/// from 6 or 10 s⁻¹ six of them found γ = 9–10 s⁻¹ at a cost lower by
-/// hundreds of σ², and their values within 0.4–0.8 pp (docs/accuracy.md,
+/// minimum. On the public-like MuJoCo stand-ins 8 of 20 tests read r₁
+/// 0.43–1.25 pp low and r⁻ 0.71–1.68 pp high, and those whose γ was printed
+/// had stopped at γ = 2.1–5.0 s⁻¹; on two of the stand-ins, started again
+/// from 6 or 10 s⁻¹, three of the five such tests found γ = 9.2–9.8 s⁻¹ at a
+/// lower cost, and their values within 0.36–0.80 pp (docs/accuracy.md,
 /// "One-sided: the restraint's damping, started again"). On the compliant
 /// random draw (seed 1064003192, 100 Hz) a restart reached a minimum 12 σ²
 /// lower with the same γ but other contact shapes, whose odd peaks were 2–7 %

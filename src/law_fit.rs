@@ -324,12 +324,16 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
     let level = ALPHA_TEST / fitted.len() as f64;
     let last = fitted.len() - 1;
     let (fin, fout) = (fitted[0].1 .1, fitted[last].1 .1);
+    // Where the inward r rises (c < 0) it is held below the inward side's own
+    // smallest amplitude, not the campaign's (one-sided: the outward pushes').
+    let inward_a_min = fitted[0].1 .2 .0.clamp(AMPLITUDE_FLOOR, 1.0);
     let parameters = |inward: SideLaw, outward: SideLaw| LawParameters {
         inward,
         outward,
         shared: rocking == Rocking::TwoSided,
         amplitude_min: a_min.clamp(AMPLITUDE_FLOOR, 1.0),
         amplitude_max: a_max.clamp(a_min.clamp(AMPLITUDE_FLOOR, 1.0), 1.0),
+        inward_amplitude_min: (rocking == Rocking::OneSided && inward.c < 0.0).then_some(inward_a_min),
     };
     let speed_loss = RestitutionLaw {
         form: LawForm::SpeedLoss,
@@ -622,9 +626,12 @@ mod tests {
             "{:?}",
             fit.notes
         );
-        // Held below the data: r at a = 0.002 is r at a = 0.02.
-        let lo = fit.law.parameters.amplitude_min;
-        assert!((fit.law.r(Side::Inward, 0.002) - fit.law.r(Side::Inward, lo)).abs() < 1e-12);
+        // Held below the inward side's own data (a = 0.02), not the campaign's
+        // smallest amplitude (the outward side's 0.002).
+        assert_eq!(fit.law.parameters.inward_amplitude_min, Some(0.02));
+        assert!((fit.law.parameters.amplitude_min - 0.002).abs() < 1e-12);
+        assert!((fit.law.r(Side::Inward, 0.005) - fit.law.r(Side::Inward, 0.02)).abs() < 1e-12);
+        assert!((fit.law.r(Side::Inward, 0.02) - (0.62 + 0.03 * speed_shape(0.02))).abs() < 1e-9);
         assert!(fit.law.r(Side::Inward, 0.02) > fit.law.r(Side::Inward, 0.3));
         // e = r e_H never passes 1, even with an e_H that would carry it past.
         assert!(fit.law.e(Side::Inward, 0.002, 1.3) <= 1.0);

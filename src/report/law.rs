@@ -199,8 +199,9 @@ fn impacts_end_list(res: &CampaignResult) -> String {
         .filter_map(|t| {
             let r = t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok())?;
             let end = r.impacts.end.as_deref()?;
+            let out_of_law = r.law_end.as_ref().map_or(String::new(), |(_, why)| format!("; {}", escape(why)));
             Some(format!(
-                "<li>{}: {} reported; {}</li>\n",
+                "<li>{}: {} reported; {}{out_of_law}</li>\n",
                 escape(&t.spec.id),
                 r.impacts.impacts.len(),
                 escape(end)

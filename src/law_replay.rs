@@ -178,6 +178,7 @@ impl LawPacking {
                 shared: self.shared,
                 amplitude_min: AMPLITUDE_FLOOR,
                 amplitude_max: 1.0,
+                inward_amplitude_min: None,
             },
         })
     }
@@ -465,6 +466,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
             shared: sides.len() == 1,
             amplitude_min: span.0.max(AMPLITUDE_FLOOR),
             amplitude_max: span.1.clamp(span.0.max(AMPLITUDE_FLOOR), 1.0),
+            inward_amplitude_min: None,
         },
     }
 }

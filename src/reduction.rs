@@ -3,7 +3,7 @@
 //! and their uncertainties. The log arrives already read ([`crate::ingest`] reads
 //! files; the Python binding passes arrays); a failure is a typed [`ReduceError`].
 
-use crate::impacts::{extend_late_contacts, extend_late_two_sided, impact_table, reread_contacts, Geometry, ImpactTable};
+use crate::impacts::{extend_late_contacts, extend_late_two_sided, impact_table, law_end, reread_contacts, Geometry, ImpactTable};
 use crate::peaks::late::{arc_contact_peaks, contact_peaks, nominal_arc, CONTACT_POST_S};
 use crate::peaks::{analyse, Analysis, PeakError, PeakOptions, Physics, Quality};
 use crate::restitution::{coefficients, uncertainties, unresolved_reason, Coefficients};
@@ -34,6 +34,10 @@ pub struct Reduced {
     pub impacts: ImpactTable,
     /// How many peaks `impacts` comes from, the late local readings included (`impacts` has one fewer).
     pub impact_peaks: usize,
+    /// One-sided walls: the first impact of `impacts` kept out of the campaign's
+    /// law and why (the wall lifts off for less than half of a half-cycle around
+    /// it: [`crate::impacts::law_end`]).
+    pub law_end: Option<(usize, String)>,
 }
 
 impl Reduced {
@@ -99,6 +103,7 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
         uncertainty: u,
         impacts: ImpactTable::default(),
         impact_peaks: 0,
+        law_end: None,
     })
 }
 
@@ -136,6 +141,7 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
             let contacts = contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S);
             extend_late_contacts(&mut table, &contacts, e_housner, &geo, Some(arc));
             reread_contacts(&mut table, &contacts, n, e_housner, &geo);
+            red.law_end = law_end(&contacts, arc, &geo).filter(|(k, _)| *k < table.impacts.len());
         }
     }
     if table.end.is_some() && table.impacts.len() + 1 >= MAX_IMPACT_PEAKS {

@@ -56,7 +56,9 @@
 //! Below the smallest (`amplitude_min`) it extrapolates where r falls with the
 //! amplitude (c ≥ 0: the fixed speed loss brings the wall to rest, as it does; r is
 //! never below 0) and holds its value at `amplitude_min` where r would rise without
-//! bound (c < 0). [`RestitutionLaw::e`] caps e = r e_H at 1.
+//! bound (c < 0; on the inward side of a one-sided wall, at the smallest amplitude
+//! of its own impacts, `inward_amplitude_min`, where it is given). [`RestitutionLaw::e`]
+//! caps e = r e_H at 1.
 //!
 //! # Uncertainty and draws
 //! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c).
@@ -167,6 +169,12 @@ pub struct LawParameters {
     /// holds its value there.
     pub amplitude_min: f64,
     pub amplitude_max: f64,
+    /// One-sided walls whose inward r rises as the amplitude falls (c < 0): the
+    /// smallest amplitude of the inward side's own impacts, below which the
+    /// inward r is held (its impacts end free arcs, far larger than the
+    /// outward side's pushes, which set `amplitude_min`). Absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inward_amplitude_min: Option<f64>,
 }
 
 /// As read from JSON, before [`RestitutionLaw::validate`].
@@ -228,6 +236,7 @@ impl RestitutionLaw {
                 shared: false,
                 amplitude_min: AMPLITUDE_FLOOR,
                 amplitude_max: 1.0,
+                inward_amplitude_min: None,
             },
         }
     }
@@ -241,16 +250,22 @@ impl RestitutionLaw {
     }
 
     /// g at the amplitude for one side (module docs, "Range"): a clamped to
-    /// [AMPLITUDE_FLOOR, 1] where c ≥ 0 and to [amplitude_min, 1] where c < 0; 0 for
-    /// a constant, so that r = r∞ exactly.
-    fn g(&self, side: &SideLaw, amplitude_over_alpha: f64) -> f64 {
+    /// [AMPLITUDE_FLOOR, 1] where c ≥ 0 and to [amplitude_min, 1] where c < 0
+    /// (the inward side: [inward_amplitude_min, 1] where it is given); 0 for a
+    /// constant, so that r = r∞ exactly.
+    fn g(&self, which: Side, amplitude_over_alpha: f64) -> f64 {
+        let side = self.side(which);
         match self.form {
             LawForm::Constant => 0.0,
             LawForm::SpeedLoss => {
                 let a = amplitude_over_alpha.abs();
                 let a = if a.is_finite() { a } else { 1.0 };
-                let lo = if side.c >= 0.0 { AMPLITUDE_FLOOR } else { self.parameters.amplitude_min };
-                speed_shape(a.clamp(lo, 1.0))
+                let lo = match (side.c >= 0.0, which, self.parameters.inward_amplitude_min) {
+                    (true, _, _) => AMPLITUDE_FLOOR,
+                    (false, Side::Inward, Some(a_in)) => a_in.max(self.parameters.amplitude_min),
+                    (false, _, _) => self.parameters.amplitude_min,
+                };
+                speed_shape(a.clamp(lo.min(1.0), 1.0))
             }
         }
     }
@@ -259,13 +274,13 @@ impl RestitutionLaw {
     /// `amplitude_over_alpha`: max(0, r∞ − c g(a)).
     pub fn r(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
         let l = self.side(side);
-        l.value(self.g(l, amplitude_over_alpha)).max(0.0)
+        l.value(self.g(side, amplitude_over_alpha)).max(0.0)
     }
 
     /// The standard uncertainty of [`Self::r`] from the parameters' covariance.
     pub fn r_u(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
         let l = self.side(side);
-        l.u(self.g(l, amplitude_over_alpha))
+        l.u(self.g(side, amplitude_over_alpha))
     }
 
     /// The coefficient the solver applies: e = min(1, r(a) e_H).
@@ -356,6 +371,11 @@ impl RestitutionLaw {
                 p.amplitude_min, p.amplitude_max
             ));
         }
+        if let Some(a) = p.inward_amplitude_min {
+            if !(a.is_finite() && (AMPLITUDE_FLOOR..=1.0).contains(&a)) {
+                return Err(format!("restitution law: inward_amplitude_min = {a} must lie in [{AMPLITUDE_FLOOR}, 1]"));
+            }
+        }
         if self.form == LawForm::Constant && (p.inward.c != 0.0 || p.outward.c != 0.0) {
             return Err("restitution law: form \"constant\" needs c = 0 on both sides".into());
         }
@@ -388,6 +408,7 @@ mod tests {
                 shared: false,
                 amplitude_min: 0.0024,
                 amplitude_max: 0.391,
+                inward_amplitude_min: None,
             },
         };
         let l = law(LawForm::SpeedLoss, side(0.6714, 0.0), side(1.1614, 0.0415));
@@ -419,6 +440,7 @@ mod tests {
                 shared: false,
                 amplitude_min: 0.01,
                 amplitude_max: 0.4,
+                inward_amplitude_min: None,
             },
         }
     }

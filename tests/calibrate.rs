@@ -217,6 +217,7 @@ fn law_test(
                     shared: true,
                     amplitude_min: 1e-6,
                     amplitude_max: 1.0,
+                    inward_amplitude_min: None,
                 },
             };
             ImpactLaw::new(std::sync::Arc::new(law), e_h)

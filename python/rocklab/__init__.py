@@ -236,7 +236,8 @@ def impacts(result: ReduceResult):
     impact of the summary's ``tests[].impacts`` that carries ``r``, with columns
     ``test``, ``status`` and every field the impact has (``k``, ``side``,
     ``amplitude_over_alpha``, ``speed_before_mm_s``, ``speed_after_mm_s``, ``e``,
-    ``e_u``, ``r``, ``r_u``, the time and signed speeds of the analysis). A DataFrame
+    ``e_u``, ``r``, ``r_u``, the time and signed speeds of the analysis, and on a
+    one-sided wall's impacts kept out of the law ``not_in_law``, why). A DataFrame
     where pandas is installed, else a list of dicts."""
     rows = [
         {"test": t["id"], "status": t.get("status"), **i}

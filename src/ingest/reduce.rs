@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::campaign_means::{campaign_means, CampaignMeans, Row};
 use crate::error::InputError;
+use crate::impacts::ImpactTable;
 use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::LogReader;
 use crate::law_fit::{fit_law, LawFit, LawFitError, TestImpacts};
@@ -197,16 +198,23 @@ pub fn campaign_result(campaign: Campaign, options: PeakOptions, tests: Vec<Test
 }
 
 /// The law of the tests the means use (status ok, not excluded from the means).
+/// A one-sided test's impacts from its `law_end` on are kept out of the fit
+/// (the wall lifts off for less than half of a half-cycle around them:
+/// [`crate::impacts::law_end`]); the table keeps them.
 fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, LawFitError> {
-    let used: Vec<TestImpacts> = tests
+    let used: Vec<(&str, std::borrow::Cow<ImpactTable>)> = tests
         .iter()
         .filter(|t| !t.spec.exclude_from_mean)
         .filter_map(|t| t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok()).map(|r| (t, r)))
-        .map(|(t, r)| TestImpacts {
-            id: &t.spec.id,
-            table: &r.impacts,
+        .map(|(t, r)| {
+            let table = match &r.law_end {
+                Some((k, _)) => std::borrow::Cow::Owned(r.impacts.first(*k)),
+                None => std::borrow::Cow::Borrowed(&r.impacts),
+            };
+            (t.spec.id.as_str(), table)
         })
         .collect();
+    let used: Vec<TestImpacts> = used.iter().map(|(id, table)| TestImpacts { id, table }).collect();
     fit_law(campaign.rocking, &used)
 }
 

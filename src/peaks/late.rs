@@ -1025,6 +1025,9 @@ fn restraint_exhaustive(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactPeak {
     pub k: usize,
+    /// The rest-line crossing that starts half-cycle k (the end of half-cycle
+    /// k − 1), s: with `crossing_s`, the half-cycle's length.
+    pub start_s: f64,
     /// The rest-line crossing that ends half-cycle k (impact k), s.
     pub crossing_s: f64,
     /// Apex |x| (mm) of half-cycle k.
@@ -1092,6 +1095,7 @@ pub fn contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f64, f
             };
             ContactPeak {
                 k,
+                start_s: c[k - 1],
                 crossing_s: c[k],
                 apex_mm: apex_between(t, &a.displacement_mm, c[k - 1], c[k]),
                 reading: m.and_then(|m| read_contact(t, &y, (c[k - 1], ONE_SIDED_FROM), c[k], post_s, m, a.noise_mm, want)),
@@ -1120,6 +1124,7 @@ pub fn arc_contact_peaks(a: &super::Analysis, t: &[f64], lever_mm: f64, arc: (f6
             };
             ContactPeak {
                 k,
+                start_s: c[k - 1],
                 crossing_s: c[k],
                 apex_mm: apex_between(t, &a.displacement_mm, c[k - 1], c[k]),
                 reading: read_contact(t, &y, (c[k - 1], TWO_SIDED_FROM), c[k], post_s, m, a.noise_mm, want),

@@ -25,12 +25,14 @@ pub fn impacts_csv(res: &CampaignResult) -> Result<Vec<u8>, ReportError> {
         "e_u",
         "r",
         "r_u",
+        "lifts_off",
     ])?;
     let opt = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:.6}"));
     for t in &res.tests {
         let Ok(r) = &t.result else { continue };
         let status = if r.analysis.quality.is_ok() { "ok" } else { "suspect" };
         for i in &r.impacts.impacts {
+            let lifts_off = r.law_end.as_ref().is_none_or(|(from, _)| i.k < *from);
             w.write_record([
                 t.spec.id.clone(),
                 status.into(),
@@ -43,6 +45,7 @@ pub fn impacts_csv(res: &CampaignResult) -> Result<Vec<u8>, ReportError> {
                 opt(i.e_u),
                 format!("{:.6}", i.r),
                 opt(i.r_u),
+                lifts_off.to_string(),
             ])?;
         }
     }
@@ -196,8 +199,9 @@ fn impacts_end_list(res: &CampaignResult) -> String {
         .filter_map(|t| {
             let r = t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok())?;
             let end = r.impacts.end.as_deref()?;
+            let out_of_law = r.law_end.as_ref().map_or(String::new(), |(_, why)| format!("; {}", escape(why)));
             Some(format!(
-                "<li>{}: {} reported; {}</li>\n",
+                "<li>{}: {} reported; {}{out_of_law}</li>\n",
                 escape(&t.spec.id),
                 r.impacts.impacts.len(),
                 escape(end)

@@ -61,15 +61,25 @@ struct ImpactDoc<'a> {
     impact: &'a Impact,
     #[serde(flatten)]
     coefficient: Option<&'a ImpactCoefficient>,
+    /// One-sided walls: why a reported coefficient is kept out of the campaign's
+    /// law (the wall lifts off for less than half of a half-cycle around it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    not_in_law: Option<&'a str>,
 }
 
-fn impact_docs(t: &ImpactTable) -> Vec<ImpactDoc<'_>> {
+fn impact_docs<'a>(t: &'a ImpactTable, law_end: Option<&'a (usize, String)>) -> Vec<ImpactDoc<'a>> {
     t.raw
         .iter()
         .enumerate()
-        .map(|(k, impact)| ImpactDoc {
-            impact,
-            coefficient: t.impacts.get(k),
+        .map(|(k, impact)| {
+            let coefficient = t.impacts.get(k);
+            ImpactDoc {
+                impact,
+                coefficient,
+                not_in_law: law_end
+                    .filter(|(from, _)| coefficient.is_some_and(|c| c.k >= *from))
+                    .map(|(_, why)| why.as_str()),
+            }
         })
         .collect()
 }
@@ -163,7 +173,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 coefficients: &r.coefficients,
                 u: r.uncertainty.as_ref().map(Uncertainties),
                 release_time_s: r.analysis.release_time_s,
-                impacts: impact_docs(&r.impacts),
+                impacts: impact_docs(&r.impacts, r.law_end.as_ref()),
                 impacts_end: r.impacts.end.as_deref(),
                 acquisition: &r.analysis.response,
                 acquisition_note: r.analysis.acquisition_note.as_deref(),

@@ -663,10 +663,10 @@ fn engine_campaigns() {
 /// NaN; a test may be ok only with every u covering its error (|err| ≤ 2 u);
 /// otherwise it is suspect with the reason. Measured: the lag is bounded (from
 /// zero up to where the contact's end reaches the next sample), and over that
-/// range the model's contact phase moves peaks 1 and 3 by up to 22 % (a
-/// short contact overshoots): u 12.9 and 15.4 %, covering errors of −0.1 and
-/// −0.7 %; the test is suspect because r₁ and r₁⁺ are then read to ± 11.5 and
-/// 12.4 pp ("the log does not resolve …").
+/// range the model's contact phase moves peaks 1 and 3 a lot (its extreme
+/// overshoots as the lag goes to zero): u 12.9 and 15.4 % (from 0), covering
+/// errors of −0.1 and −0.7 %; the test is suspect because r₁ and r₁⁺ are then
+/// read to ± 11.5 and 12.4 pp ("the log does not resolve …").
 #[test]
 fn an_undetermined_fit_states_no_zero_uncertainty() {
     let name = "penalty-one-sided-singular";

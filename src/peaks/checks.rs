@@ -13,6 +13,8 @@
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |
 //! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 % |
+//! | [`undetermined_parameters`] | a peak read from the global fit depends on a direction of its parameters that the log does not determine and does not bound (its uncertainty cannot be computed) |
+//! | [`not_a_covariance`] | the peaks' covariance is not finite, symmetric and positive semi-definite with a positive variance for every peak |
 //! | [`disagreement`] | the local re-fit of an arc's end disagrees with the global fit by more than 4 combined standard uncertainties + 3 % |
 //!
 //! The thresholds were set on the random draws of `tests/random_draw.rs`: a
@@ -205,6 +207,56 @@ pub fn zero_readings_disagree(v: &[f64], spread: &[f64]) -> Option<String> {
             )
         })
     })
+}
+
+/// The peaks' uncertainty cannot be computed where a peak read from the global
+/// fit (`global[k]`) depends on a direction of the fit's parameters that the
+/// log does not determine and that has no admissible range
+/// (`undetermined[k]`, its parameters in words,
+/// [`super::model::Fitted::peak_covariance`]): the covariance says nothing
+/// about that direction, and stating it would claim a precision the log does
+/// not have. (Issue U: the lag of contacts that all fall between two samples,
+/// whose broken inverse had printed u = 0, is bounded by those samples: its
+/// range is a term of u, [`super::model::Fitted::admissible_spread`].)
+pub fn undetermined_parameters(undetermined: &[Option<String>], global: &[bool]) -> Option<String> {
+    undetermined.iter().enumerate().find_map(|(k, names)| {
+        let names = names.as_ref().filter(|_| global.get(k).copied().unwrap_or(true))?;
+        Some(format!(
+            "the fit's parameters are not all determined by the log ({names}), and peak {k} depends on them with no bound on their range: its uncertainties cannot be computed"
+        ))
+    })
+}
+
+/// The peaks' covariance must be one: finite, symmetric, a positive variance
+/// for every peak and no negative eigenvalue beyond rounding (10⁻⁹ of the
+/// largest). Anything else would be stated as a u of 0 or NaN. The check
+/// behind [`undetermined_parameters`]: no path should reach it.
+pub fn not_a_covariance(cov: &[Vec<f64>]) -> Option<String> {
+    let n = cov.len();
+    let bad = |why: String| {
+        Some(format!(
+            "the peaks' covariance is not a covariance ({why}): their uncertainties cannot be computed"
+        ))
+    };
+    if cov.iter().any(|row| row.len() != n || row.iter().any(|v| !v.is_finite())) {
+        return bad("not a finite square matrix".into());
+    }
+    if let Some(k) = (0..n).find(|&k| cov[k][k] <= 0.0) {
+        return bad(format!("the variance of peak {k} is {:.3e}", cov[k][k]));
+    }
+    for a in 0..n {
+        for b in 0..a {
+            if (cov[a][b] - cov[b][a]).abs() > 1e-9 * (cov[a][a] * cov[b][b]).sqrt() {
+                return bad(format!("not symmetric at peaks {b}, {a}"));
+            }
+        }
+    }
+    let m = nalgebra::DMatrix::from_fn(n, n, |a, b| 0.5 * (cov[a][b] + cov[b][a]));
+    let eig = m.symmetric_eigenvalues();
+    let (lo, hi) = (eig.min(), eig.max());
+    (lo < -1e-9 * hi)
+        .then_some(())
+        .and_then(|_| bad(format!("an eigenvalue of {lo:.3e} against {hi:.3e}")))
 }
 
 /// The local estimate of the slope at `t_end` from the samples (t, y) of one arc:

@@ -476,7 +476,14 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Each peak's two readings of where its half-cycle ends (zero without
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
-    let cov = fit.fitted.peak_covariance(n_peaks).map(|mut c| {
+    let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
+    let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
+    let cov = peak_cov.map(|pc| {
+        let mut c = pc.cov;
+        // Directions the log does not determine, each over its admissible range.
+        for e in &pc.bounded {
+            uncertainty::add_admissible_range(&mut c, e);
+        }
         if !fit.contacts {
             uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
         }
@@ -506,7 +513,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         .map(|(k, i)| Peak {
             time_s: i.time_s,
             velocity_mm_s: i.v_before_mm_s,
-            velocity_u_mm_s: cov.as_ref().map(|c| c[k][k].max(0.0).sqrt()),
+            // Never clamped: a variance that is not positive is caught below
+            // (checks::not_a_covariance), not stated as u = 0.
+            velocity_u_mm_s: cov.as_ref().map(|c| c[k][k].sqrt()),
         })
         .collect();
     // Per impact: the local reading where the log resolves a smooth extreme.
@@ -535,6 +544,16 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     };
     let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
+    // Where the uncertainties cannot be computed, none is stated (never u = 0):
+    // a peak read from the global fit that depends on parameters the log does
+    // not determine, or a covariance that is not one.
+    let global: Vec<bool> = methods.iter().map(|&m| m != ReadingMethod::LocalExtreme).collect();
+    let uncomputable = checks::undetermined_parameters(&undetermined, &global).or_else(|| cov.as_deref().and_then(checks::not_a_covariance));
+    if uncomputable.is_some() {
+        cov = None;
+        peaks.iter_mut().for_each(|p| p.velocity_u_mm_s = None);
+    }
+    let verdict = verdict.with(uncomputable);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,

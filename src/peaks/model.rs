@@ -26,6 +26,7 @@
 
 use super::restraint::InwardArc;
 use crate::fit::{levenberg_marquardt, FitResult};
+use nalgebra::DVector;
 
 /// Names of the positions in the parameter vector. Rates and lengths are stored
 /// as logarithms so that they stay positive; λ and γ are signed.
@@ -89,6 +90,34 @@ impl Layout {
     }
     pub fn lag(&self, k: usize) -> usize {
         self.delta(k) + 2
+    }
+    /// Parameter j in words (for the reasons of the checks).
+    pub fn name(&self, j: usize) -> String {
+        let contact = ix::IMPACT0 + self.impacts;
+        if j >= contact {
+            let what = ["the offset δ", "the lead u", "the lag w"][(j - contact) % 3];
+            let whose = match (self.by_direction, (j - contact) / 3) {
+                (false, _) => "the contacts",
+                (true, 0) => "the contacts entering the inward side",
+                (true, _) => "the contacts entering the outward side",
+            };
+            return format!("{what} of {whose}");
+        }
+        if j >= ix::IMPACT0 {
+            return format!("the time of impact {}", j - ix::IMPACT0);
+        }
+        [
+            "the sensor zero",
+            "the sensor drift",
+            "A of the small arcs",
+            "p of the small arcs",
+            "λ of the inward arcs",
+            "A₀ of the release arc",
+            "p₀ of the release arc",
+            "the release time",
+            "γ of the inward arcs",
+        ][j]
+            .to_string()
     }
 }
 
@@ -564,18 +593,58 @@ pub struct Fitted {
     pub free: Vec<usize>,
 }
 
+/// The peaks' covariance from the fit ([`Fitted::peak_covariance`]).
+#[derive(Debug, Clone)]
+pub struct PeakCovariance {
+    /// Σ_v (mm²/s²), on the directions the log determines.
+    pub cov: Vec<Vec<f64>>,
+    /// For each peak whose speed moves along a direction of the parameters
+    /// that the log does not determine ([`crate::fit::FitResult::undetermined`])
+    /// and that has no bound ([`Fitted::admissible_spread`]), the parameters of
+    /// that direction in words: its uncertainty cannot be computed (the
+    /// covariance leaves that direction out). None elsewhere.
+    pub undetermined: Vec<Option<String>>,
+    /// For each undetermined direction with a bound that some peak depends on:
+    /// the peaks' spread e over its admissible range, a fully correlated term
+    /// Σ_v += e eᵀ of their covariance ([`Fitted::admissible_spread`]).
+    pub bounded: Vec<Vec<f64>>,
+}
+
+/// Doublings of the step along an undetermined direction before it is taken
+/// as unbounded: 2⁴⁰ finite-difference steps (10⁸ in ln u or ln w of a
+/// contact, 10⁶ s in a time), far past any physical range.
+const DOUBLINGS: usize = 40;
+
+/// Bisections of the last doubling that failed ([`Fitted::admissible_spread`]):
+/// the range's end to 2⁻²⁴ of itself.
+const BISECTIONS: usize = 24;
+
+/// A peak depends on a direction the log does not determine when one step
+/// along it (its largest component one finite-difference step) moves the
+/// speed by more than 10⁻⁹ of itself: far above the rounding of the speeds
+/// and their central differences (~10⁻¹⁵), so any real dependence counts (the
+/// data bound no part of such a direction, so any slope along it is an
+/// unbounded uncertainty). Issue U: 4·10⁻⁸ (the outward contacts' lag).
+const DEPENDS: f64 = 1e-9;
+
 impl Fitted {
     /// Standard uncertainty and covariance of the peak speeds v_0..v_{n−1} (mm/s),
     /// propagated from the fit's covariance s² (JᵀJ)⁻¹ by the Jacobian of the
-    /// speeds (central differences): Σ_v = G Σ_q Gᵀ. None when JᵀJ is singular.
-    pub fn peak_covariance(&self, n: usize) -> Option<Vec<Vec<f64>>> {
+    /// speeds (central differences): Σ_v = G Σ_q Gᵀ; for each direction the
+    /// log (`tw`, `yw`: the fitted window) does not determine that a peak
+    /// depends on, the peaks' spread over its admissible range where it has
+    /// one, otherwise which peaks depend on it (then Σ_v understates them and
+    /// must not be stated). None when the fit has no covariance.
+    pub fn peak_covariance(&self, n: usize, tw: &[f64], yw: &[f64]) -> Option<PeakCovariance> {
         let cov = self.fit.covariance.as_ref()?;
         let n = n.min(self.model.m());
         let speeds = |m: &Model| -> Vec<f64> { (0..n).map(|k| m.peak(k).1).collect() };
         let np = self.free.len();
         let mut g = vec![vec![0.0; np]; n];
+        let mut steps = vec![0.0; np];
         for (c, &j) in self.free.iter().enumerate() {
             let h = step_for(&self.model, j);
+            steps[c] = h;
             let mut up = self.model.clone();
             up.q[j] += h;
             let mut dn = self.model.clone();
@@ -597,7 +666,161 @@ impl Fitted {
                 out[a][b] = s;
             }
         }
-        Some(out)
+        let v = speeds(&self.model);
+        let mut undetermined: Vec<Option<String>> = vec![None; n];
+        let mut bounded = Vec::new();
+        for dir in &self.fit.undetermined {
+            let depends: Vec<bool> = (0..n)
+                .map(|k| {
+                    let moved: f64 = (0..np).map(|c| g[k][c] * dir[c]).sum();
+                    !moved.is_finite() || moved.abs() > DEPENDS * v[k].abs()
+                })
+                .collect();
+            if !depends.contains(&true) {
+                continue;
+            }
+            if let Some(e) = self.admissible_spread(dir, tw, yw, &v) {
+                bounded.push(e);
+                continue;
+            }
+            let names: Vec<String> = (0..np)
+                .filter(|&c| dir[c].abs() >= 0.1 * steps[c])
+                .map(|c| self.model.layout.name(self.free[c]))
+                .collect();
+            for (k, slot) in undetermined.iter_mut().enumerate() {
+                if depends[k] && slot.is_none() {
+                    *slot = Some(names.join(", "));
+                }
+            }
+        }
+        Some(PeakCovariance {
+            cov: out,
+            undetermined,
+            bounded,
+        })
+    }
+
+    /// The peaks' spread over the admissible range of a direction `dir` (in
+    /// the fitted parameters) that the log does not determine, or None where
+    /// that range has no bound.
+    ///
+    /// The range: every point q + s·dir whose model is valid and whose cost
+    /// on the fitted window stays within one residual variance of the fit's,
+    /// cost(s) ≤ cost(0) (1 + 1/(n − p)) (the profile's one-σ interval of a
+    /// parameter the data see). A direction no residual sees has a flat cost
+    /// up to a physical bound: a contact lag whose end falls between two
+    /// samples at every impact of its direction moves freely until that end
+    /// reaches a sample (then the sample falls inside the contact phase and the
+    /// cost rises), or down to a lag of zero, where the peaks stop changing;
+    /// a time ordering that [`Model::valid`] refuses ends it too. Searched by
+    /// doubling s from one step in each sign, then bisecting the first
+    /// doubling refused ([`BISECTIONS`]). Where [`DOUBLINGS`] doublings are all
+    /// admissible, the range has a bound only if the peaks have stopped
+    /// changing over the last one (by at most [`DEPENDS`] of themselves, as a
+    /// lag of zero); otherwise None.
+    ///
+    /// The truth is taken as anywhere in the range (rectangular), the fitted
+    /// point wherever it lies in it: with lo_k ≤ 0 ≤ hi_k the least and
+    /// largest change of peak k over the points visited (the doublings, the
+    /// bisections and 16 evenly spaced points), the mean square distance of the
+    /// fitted peak from the truth is (lo² + lo hi + hi²)/3 (d²/12 for a fit in
+    /// the middle of a range of width d, d²/3 at one end, as
+    /// `uncertainty::add_zero_spread` and `add_model_spread`). One cause moves
+    /// every peak, so the term is fully correlated: e_k is that root mean
+    /// square with the sign of peak k's change from one end of the range to
+    /// the other.
+    pub fn admissible_spread(&self, dir: &DVector<f64>, tw: &[f64], yw: &[f64], v0: &[f64]) -> Option<Vec<f64>> {
+        let n = v0.len();
+        let at = |s: f64| {
+            let mut m = self.model.clone();
+            for (c, &j) in self.free.iter().enumerate() {
+                m.q[j] += s * dir[c];
+            }
+            m
+        };
+        let cost = |m: &Model| {
+            let mut r = Vec::new();
+            m.residuals(tw, yw, &mut r)
+                .then(|| r.iter().map(|x| x * x).sum::<f64>())
+                .filter(|c| c.is_finite())
+        };
+        let c0 = cost(&self.model)?;
+        let dof = tw.len().saturating_sub(self.free.len()).max(1) as f64;
+        let allowed = c0 * (1.0 + 1.0 / dof);
+        let admissible = |s: f64| -> Option<Vec<f64>> {
+            let m = at(s);
+            cost(&m).filter(|&c| c <= allowed)?;
+            let p: Vec<f64> = (0..n).map(|k| m.peak(k).1).collect();
+            p.iter().all(|x| x.is_finite()).then_some(p)
+        };
+        let mut visited: Vec<(f64, Vec<f64>)> = vec![(0.0, v0.to_vec())];
+        let mut ends = [0.0; 2];
+        for (end, sign) in ends.iter_mut().zip([-1.0, 1.0]) {
+            let (mut good, mut refused) = (0.0, None);
+            let mut last: Vec<Vec<f64>> = Vec::new();
+            let mut s = 1.0;
+            for _ in 0..DOUBLINGS {
+                match admissible(sign * s) {
+                    Some(p) => {
+                        good = s;
+                        visited.push((sign * s, p.clone()));
+                        last.push(p);
+                        s *= 2.0;
+                    }
+                    None => {
+                        refused = Some(s);
+                        break;
+                    }
+                }
+            }
+            match refused {
+                Some(mut bad) => {
+                    for _ in 0..BISECTIONS {
+                        let mid = 0.5 * (good + bad);
+                        match admissible(sign * mid) {
+                            Some(p) => {
+                                good = mid;
+                                visited.push((sign * mid, p));
+                            }
+                            None => bad = mid,
+                        }
+                    }
+                }
+                None => {
+                    let settled = last.len() >= 2 && {
+                        let (a, b) = (&last[last.len() - 2], &last[last.len() - 1]);
+                        (0..n).all(|k| (a[k] - b[k]).abs() <= DEPENDS * v0[k].abs())
+                    };
+                    if !settled {
+                        return None;
+                    }
+                }
+            }
+            *end = sign * good;
+        }
+        for i in 1..16 {
+            let s = ends[0] + (ends[1] - ends[0]) * i as f64 / 16.0;
+            if let Some(p) = admissible(s) {
+                visited.push((s, p));
+            }
+        }
+        let first = visited.iter().min_by(|a, b| a.0.total_cmp(&b.0))?;
+        let final_ = visited.iter().max_by(|a, b| a.0.total_cmp(&b.0))?;
+        let e = (0..n)
+            .map(|k| {
+                let (lo, hi) = visited
+                    .iter()
+                    .map(|(_, p)| p[k] - v0[k])
+                    .fold((0.0f64, 0.0f64), |(lo, hi), d| (lo.min(d), hi.max(d)));
+                let rms = ((lo * lo + lo * hi + hi * hi) / 3.0).sqrt();
+                if final_.1[k] >= first.1[k] {
+                    rms
+                } else {
+                    -rms
+                }
+            })
+            .collect();
+        Some(e)
     }
 }
 
@@ -794,6 +1017,78 @@ mod tests {
         let mut plain = two_sided(false);
         plain.q[ix::ZERO] = -3.0;
         assert!((0..3).all(|k| plain.peak_spread(k) == 0.0), "no contact phases");
+    }
+
+    /// A contact that falls between two samples (issue U): its lag moves no
+    /// residual until the contact's end reaches the next sample, so it is
+    /// undetermined yet bounded, from zero up to that sample. The peaks it
+    /// moves get the root mean square distance from their values over that
+    /// range (here computed on a fine grid of lags); a direction that moves
+    /// no peak and no residual adds nothing.
+    #[test]
+    fn a_contact_between_two_samples_is_bounded_by_them() {
+        // Contacts of 2 ms on either side of t_k = 0.5, 1.5, 2.4 s; samples at
+        // 100 Hz, 5 ms off the impacts: none inside a contact.
+        let model = two_sided(false).with_contacts(0.002);
+        let t: Vec<f64> = (0..239).map(|i| 0.005 + 0.01 * i as f64).collect();
+        let y: Vec<f64> = model.eval_many(&t).map(|m| m.unwrap().0).collect();
+        let free = model.free();
+        let lag = free.iter().position(|&j| j == model.layout.lag(0)).unwrap();
+        let fit = FitResult {
+            q: free.iter().map(|&j| model.q[j]).collect(),
+            cost: 0.0,
+            residuals: vec![0.0; t.len()],
+            iterations: 0,
+            stop: crate::fit::FitStop::Converged,
+            covariance: None,
+            undetermined: Vec::new(),
+        };
+        let fitted = Fitted {
+            model: model.clone(),
+            fit,
+            free,
+        };
+        let v0: Vec<f64> = (0..3).map(|k| model.peak(k).1).collect();
+        let mut dir = DVector::zeros(fitted.free.len());
+        dir[lag] = 1e-4;
+        let e = fitted.admissible_spread(&dir, &t, &y, &v0).expect("bounded");
+        // The lag's range: (0, 5 ms] (the contact of impact 0 ends at
+        // 0.502 s, the next sample is 0.505 s; impact 1's is 1.502 and 1.505).
+        let mut m = model.clone();
+        let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
+        for i in 1..=5000 {
+            m.q[m.layout.lag(0)] = (1e-6 * i as f64).ln();
+            for k in 0..3 {
+                let d = m.peak(k).1 - v0[k];
+                lo[k] = lo[k].min(d);
+                hi[k] = hi[k].max(d);
+            }
+        }
+        for k in 0..2 {
+            let want = ((lo[k] * lo[k] + lo[k] * hi[k] + hi[k] * hi[k]) / 3.0).sqrt();
+            assert!(want > 1.0, "peak {k} depends on the lag: {want} mm/s");
+            assert!((e[k].abs() / want - 1.0).abs() < 0.01, "peak {k}: {} against {want}", e[k]);
+        }
+        // Up to 5 ms no residual moves; beyond, a sample is inside the contact.
+        let mut r = Vec::new();
+        for (w, seen) in [(0.0049f64, false), (0.0051, true)] {
+            m.q[m.layout.lag(0)] = w.ln();
+            assert!(m.residuals(&t, &y, &mut r));
+            assert_eq!(
+                r.iter().any(|r| *r != 0.0),
+                seen,
+                "lag {w}: {:e}",
+                r.iter().fold(0.0f64, |a, r| a.max(r.abs()))
+            );
+        }
+        // The drift is not a fitted parameter; the sensor zero is seen by
+        // every residual: one step of it is refused at once, and moves every
+        // peak by nothing (the zero line is not part of a speed).
+        let zero = fitted.free.iter().position(|&j| j == ix::ZERO).unwrap();
+        let mut dz = DVector::zeros(fitted.free.len());
+        dz[zero] = 1e-7;
+        let e = fitted.admissible_spread(&dz, &t, &y, &v0).expect("bounded at once");
+        assert!(e.iter().all(|e| e.abs() < 1e-9), "{e:?}");
     }
 
     /// Two impacts may not collapse onto one instant.

@@ -53,6 +53,16 @@ pub(super) fn add_zero_spread(cov: &mut [Vec<f64>], spread: &[f64]) {
     add_correlated(cov, spread, 1.0 / 12.0);
 }
 
+/// The part of the uncertainty from a direction of the fit's parameters that
+/// the log does not determine but bounds (a contact lag whose end falls
+/// between two samples: it may lie anywhere up to the next sample): e_k is
+/// the root mean square distance of peak k from its values over that range
+/// ([`model::Fitted::admissible_spread`]); one cause, so fully correlated,
+/// Σ += e eᵀ.
+pub(super) fn add_admissible_range(cov: &mut [Vec<f64>], e: &[f64]) {
+    add_correlated(cov, e, 1.0);
+}
+
 /// Σ += w d dᵀ: a term whose parts share one cause (fully correlated).
 fn add_correlated(cov: &mut [Vec<f64>], d: &[f64], w: f64) {
     for (a, row) in cov.iter_mut().enumerate() {

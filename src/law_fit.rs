@@ -19,6 +19,9 @@
 //!
 //! One-sided rocking fits each side on its own impacts; two-sided rocking fits one
 //! law to all impacts (the sides are the same contact).
+//! The outward side of a one-sided wall is fitted with g(a) = 1/a
+//! ([`crate::restitution_law::Shape::Push`]: its impacts end a push against the
+//! transverse walls, speed ∝ amplitude); every other side with 1/√(a(2 − a)).
 //!
 //! # The form's own misfit (Paule–Mandel)
 //! No two-parameter law follows a real wall exactly (each MuJoCo test follows
@@ -71,7 +74,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::impacts::ImpactTable;
-use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, SideLaw, AMPLITUDE_FLOOR};
+use crate::restitution_law::{LawForm, LawParameters, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
 use crate::wall::{Rocking, Side};
 
 /// Level of the test against a constant (before the Bonferroni split over sides).
@@ -201,8 +204,8 @@ impl Normal {
     }
 }
 
-fn law_row(a: f64) -> Vec<f64> {
-    vec![1.0, -speed_shape(a.max(AMPLITUDE_FLOOR))]
+fn law_row(shape: Shape, a: f64) -> Vec<f64> {
+    vec![1.0, -shape.eval(a.max(AMPLITUDE_FLOOR))]
 }
 
 fn const_row(_: f64) -> Vec<f64> {
@@ -212,7 +215,7 @@ fn const_row(_: f64) -> Vec<f64> {
 /// The fit of the impacts of `sides` (one side, or both for two-sided rocking).
 /// The normal equations of the law and of the constant over the impacts of
 /// `sides`, each impact's variance raised by τ² (the form's own misfit).
-fn normals(tests: &[TestImpacts], sides: &[Side], tau2: f64) -> (Normal, Normal) {
+fn normals(tests: &[TestImpacts], sides: &[Side], shape: Shape, tau2: f64) -> (Normal, Normal) {
     let mut law = Normal::new(2);
     let mut cst = Normal::new(1);
     for t in tests {
@@ -223,7 +226,7 @@ fn normals(tests: &[TestImpacts], sides: &[Side], tau2: f64) -> (Normal, Normal)
         if idx.is_empty() {
             continue;
         }
-        law.add(t.table, cov, &idx, &law_row, tau2);
+        law.add(t.table, cov, &idx, &|a| law_row(shape, a), tau2);
         cst.add(t.table, cov, &idx, &const_row, tau2);
     }
     (law, cst)
@@ -232,9 +235,9 @@ fn normals(tests: &[TestImpacts], sides: &[Side], tau2: f64) -> (Normal, Normal)
 /// The form's own misfit τ (Paule–Mandel): the τ² ≥ 0 at which the law's χ²
 /// over ν = n − 2 is 1 (0 where the u already cover the scatter), by bisection on
 /// ln τ² (χ² falls as τ² grows).
-fn form_variance(tests: &[TestImpacts], sides: &[Side]) -> f64 {
+fn form_variance(tests: &[TestImpacts], sides: &[Side], shape: Shape) -> f64 {
     let chi2_per_dof = |tau2: f64| {
-        let (law, _) = normals(tests, sides, tau2);
+        let (law, _) = normals(tests, sides, shape, tau2);
         let dof = law.n.saturating_sub(2).max(1) as f64;
         law.solve().map_or(0.0, |(_, _, chi2)| chi2 / dof)
     };
@@ -253,18 +256,18 @@ fn form_variance(tests: &[TestImpacts], sides: &[Side]) -> f64 {
     hi.exp()
 }
 
-fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Result<(SideLaw, SideFit, (f64, f64)), LawFitError> {
-    let (law0, _) = normals(tests, sides, 0.0);
+fn fit_group(tests: &[TestImpacts], sides: &[Side], shape: Shape, label: &'static str) -> Result<(SideLaw, SideFit, (f64, f64)), LawFitError> {
+    let (law0, _) = normals(tests, sides, shape, 0.0);
     if law0.n < 4 {
         return Err(LawFitError::TooFewImpacts { side: label, n: law0.n });
     }
-    let tau2 = form_variance(tests, sides);
-    let (law, cst) = normals(tests, sides, tau2);
+    let tau2 = form_variance(tests, sides, shape);
+    let (law, cst) = normals(tests, sides, shape, tau2);
     let (beta, inv, chi2_l) = law.solve().ok_or(LawFitError::NotIdentifiable(label))?;
     let (beta_c, inv_c, chi2_c) = cst.solve().ok_or(LawFitError::NotIdentifiable(label))?;
     // Amplitudes that hardly spread leave c undetermined: its u then exceeds the whole
     // change of r over the observed range many times over.
-    let g_span = speed_shape(law.a_min.max(AMPLITUDE_FLOOR)) - speed_shape(law.a_max.max(AMPLITUDE_FLOOR));
+    let g_span = shape.eval(law.a_min.max(AMPLITUDE_FLOOR)) - shape.eval(law.a_max.max(AMPLITUDE_FLOOR));
     if g_span.is_nan() || g_span <= 1e-6 || !inv[(1, 1)].is_finite() {
         return Err(LawFitError::NotIdentifiable(label));
     }
@@ -283,6 +286,7 @@ fn fit_group(tests: &[TestImpacts], sides: &[Side], label: &'static str) -> Resu
         r_inf: beta[0],
         c: beta[1],
         cov,
+        g: shape,
     };
     let fit = SideFit {
         impacts: law.n,
@@ -318,7 +322,7 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
     };
     let mut fitted = Vec::new();
     for (label, sides) in &groups {
-        fitted.push((*label, fit_group(tests, sides, label)?));
+        fitted.push((*label, fit_group(tests, sides, Shape::of(rocking, sides[sides.len() - 1]), label)?));
     }
     let (a_min, a_max) = fitted.iter().fold((1.0f64, 0.0f64), |(lo, hi), f| (lo.min(f.1 .2 .0), hi.max(f.1 .2 .1)));
     let level = ALPHA_TEST / fitted.len() as f64;
@@ -510,6 +514,7 @@ fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::impacts::ImpactCoefficient;
+    use crate::restitution_law::speed_shape;
 
     /// F(1, ν) = t²(ν): P(F(1, 10) > 4.9646) = 0.05 (tables: t₀.₉₇₅(10) = 2.2281);
     /// P(F(2, 20) > 3.4928) = 0.05; I_x(1, 1) = x.
@@ -653,6 +658,42 @@ mod tests {
         let t = table(&flat, 0.003);
         let fit = fit_law(Rocking::OneSided, &[TestImpacts { id: "a", table: &t }]).unwrap();
         assert_eq!(fit.law.parameters.inward.c, 0.0, "{:?}", fit.sides);
+    }
+
+    /// One-sided outward impacts on r = r∞ − c/a (the push shape) give back r∞ and
+    /// c exactly, and the law says so (`"g": "push"`); the inward side and every
+    /// two-sided law keep 1/√(a(2 − a)). The same data fitted two-sided (the
+    /// free-arc shape) miss them: the test can fail.
+    #[test]
+    fn a_one_sided_outward_push_law_recovers_c() {
+        use crate::restitution_law::push_shape;
+        let amps = [0.05, 0.04, 0.03, 0.02, 0.015, 0.01, 0.007];
+        let mut pts: Vec<(f64, f64, Side)> = amps.iter().map(|&a| (a * 8.0, 0.66, Side::Inward)).collect();
+        pts.iter_mut().enumerate().for_each(|(i, p)| p.1 += if i % 2 == 0 { 0.01 } else { -0.01 });
+        pts.extend(amps.iter().map(|&a| (a, 1.05 - 0.004 * push_shape(a), Side::Outward)));
+        let t = table(&pts, 0.003);
+        let fit = fit_law(Rocking::OneSided, &[TestImpacts { id: "a", table: &t }]).unwrap();
+        let out = fit.law.parameters.outward;
+        assert_eq!(out.g, Shape::Push);
+        assert!((out.r_inf - 1.05).abs() < 1e-9 && (out.c - 0.004).abs() < 1e-9, "{out:?}");
+        assert!((fit.law.r(Side::Outward, 0.012) - (1.05 - 0.004 / 0.012)).abs() < 1e-9);
+        assert_eq!(fit.law.parameters.inward.g, Shape::Free);
+        let f = fit.sides[1].1;
+        assert!((f.trend - 0.004 * (push_shape(0.007) - push_shape(0.05))).abs() < 1e-9, "{f:?}");
+        let two = fit_law(
+            Rocking::TwoSided,
+            &[TestImpacts {
+                id: "a",
+                table: &table(&pts[7..], 0.003),
+            }],
+        )
+        .unwrap();
+        assert_eq!(two.speed_loss.parameters.inward.g, Shape::Free);
+        assert!(
+            (two.speed_loss.parameters.inward.c - 0.004).abs() > 1e-3,
+            "{:?}",
+            two.speed_loss.parameters.inward
+        );
     }
 
     #[test]

@@ -35,6 +35,10 @@
 //! calibration's means; covariance the tests' sample covariance / n, or the one
 //! test's own), against the mean of the tests' constants by replay.
 //!
+//! The replay fits every side with the free-arc shape g(a) = 1/√(a (2 − a))
+//! ([`Shape::Free`]), one-sided outward included: the push shape 1/a
+//! ([`crate::restitution_law`]) is the law from the readings' alone.
+//!
 //! No crate replays rocking: the solver is ours ([`crate::solver`]); the fit is
 //! the calibration's own Levenberg–Marquardt.
 
@@ -43,7 +47,7 @@ use std::sync::Arc;
 use crate::calibrate::{nuisance_of, replay_with, steps_nuisance, window_to, CampaignInput, Geometry, Nuisance, TestFit, TestWindow};
 use crate::fit::{least_squares, FitResult, FitStop};
 use crate::reduction::Reduced;
-use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, SideLaw, AMPLITUDE_FLOOR};
+use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
 use crate::solver::impact::ImpactLaw;
 
 /// How the calibration fits the restitution law (issue 20; `law_by_replay` in
@@ -169,6 +173,7 @@ impl LawPacking {
             r_inf: s[0],
             c: s[1],
             cov: [[0.0; 2]; 2],
+            g: Shape::Free,
         };
         Some(RestitutionLaw {
             form: LawForm::SpeedLoss,
@@ -444,6 +449,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
                 r_inf: s.r_inf,
                 c: s.c,
                 cov: s.cov,
+                g: Shape::Free,
             }
         } else {
             SideLaw::constant(s.constant_r, s.constant_u)

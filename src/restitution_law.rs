@@ -6,7 +6,11 @@
 //!
 //!   r(a) = r∞ − c · g(a),   g(a) = 1 / √(a (2 − a)),
 //!
-//! with the two parameters (r∞, c) per side and their covariance.
+//! with the two parameters (r∞, c) per side and their covariance. The outward side of
+//! a one-sided wall uses g(a) = 1/a instead ([`Shape::Push`], `"g": "push"` in its
+//! parameters): its impacts end the inward half-cycle, a push against the transverse
+//! walls' spring, where the speed is proportional to the amplitude (ω⁻ ∝ a), so the
+//! same fixed Δω gives r = r∞ − c/a. A side without `"g"` is the free arc below.
 //!
 //! Why this form. Housner's impact (paper Eq. 2) takes a fixed *fraction* of the
 //! angular speed: ω⁺ = e ω⁻, so e does not depend on the amplitude. A real contact
@@ -86,12 +90,52 @@ impl LawForm {
     }
 }
 
-/// The parameters of one side: r∞, c and their covariance [[var r∞, cov], [cov, var c]].
+/// The shape g(a) of one side's speed loss (`"g"` in a side's parameters;
+/// absent = [`Shape::Free`], so laws written before it read as they did).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shape {
+    /// g(a) = 1/√(a (2 − a)): the impact ends a free (gravity) arc, ω⁻ ∝ √(a(2 − a)).
+    #[default]
+    Free,
+    /// g(a) = 1/a: the impact ends a push against a spring (the outward impacts of a
+    /// one-sided wall end the inward half-cycle, pushed back by the transverse walls):
+    /// ω⁻ ∝ a, so a fixed Δω gives r = r∞ − c/a (g(1) = 1 as for the free arc).
+    Push,
+}
+
+impl Shape {
+    /// g(a) for a in (0, 1].
+    pub fn eval(self, a: f64) -> f64 {
+        match self {
+            Shape::Free => speed_shape(a),
+            Shape::Push => push_shape(a),
+        }
+    }
+
+    /// The shape a fit uses on `side` of a wall rocking `rocking`: the push on the
+    /// outward side of a one-sided wall, the free arc everywhere else.
+    pub fn of(rocking: crate::wall::Rocking, side: Side) -> Shape {
+        match (rocking, side) {
+            (crate::wall::Rocking::OneSided, Side::Outward) => Shape::Push,
+            _ => Shape::Free,
+        }
+    }
+
+    pub fn is_free(&self) -> bool {
+        *self == Shape::Free
+    }
+}
+
+/// The parameters of one side: r∞, c and their covariance [[var r∞, cov], [cov, var c]],
+/// and the shape g of the speed loss.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SideLaw {
     pub r_inf: f64,
     pub c: f64,
     pub cov: [[f64; 2]; 2],
+    #[serde(default, skip_serializing_if = "Shape::is_free")]
+    pub g: Shape,
 }
 
 impl SideLaw {
@@ -101,6 +145,7 @@ impl SideLaw {
             r_inf: r,
             c: 0.0,
             cov: [[u * u, 0.0], [0.0, 0.0]],
+            g: Shape::Free,
         }
     }
 
@@ -123,6 +168,7 @@ impl SideLaw {
             r_inf: self.r_inf + l00 * z0,
             c: self.c + l10 * z0 + l11 * z1,
             cov: [[0.0; 2]; 2],
+            g: self.g,
         }
     }
 
@@ -222,6 +268,11 @@ pub fn speed_shape(a: f64) -> f64 {
     1.0 / (a * (2.0 - a)).sqrt()
 }
 
+/// g(a) = 1/a = ω(1)/ω⁻ for an impact that ends a push against a spring ([`Shape::Push`]).
+pub fn push_shape(a: f64) -> f64 {
+    1.0 / a
+}
+
 /// The smallest amplitude a law may start at (g(1e-6) ≈ 707).
 pub const AMPLITUDE_FLOOR: f64 = 1e-6;
 
@@ -265,7 +316,7 @@ impl RestitutionLaw {
                     (false, Side::Inward, Some(a_in)) => a_in.max(self.parameters.amplitude_min),
                     (false, _, _) => self.parameters.amplitude_min,
                 };
-                speed_shape(a.clamp(lo.min(1.0), 1.0))
+                side.g.eval(a.clamp(lo.min(1.0), 1.0))
             }
         }
     }
@@ -399,6 +450,7 @@ mod tests {
             r_inf,
             c,
             cov: [[0.0; 2]; 2],
+            g: Shape::Free,
         };
         let law = |form, inward, outward| RestitutionLaw {
             form,
@@ -431,11 +483,13 @@ mod tests {
                     r_inf: 0.70,
                     c: 0.0,
                     cov: [[1e-4, 0.0], [0.0, 1e-6]],
+                    g: Shape::Free,
                 },
                 outward: SideLaw {
                     r_inf: 1.02,
                     c: 0.02,
                     cov: [[4e-4, -2e-5], [-2e-5, 4e-6]],
+                    g: Shape::Free,
                 },
                 shared: false,
                 amplitude_min: 0.01,
@@ -523,6 +577,42 @@ mod tests {
         assert!(c
             .windows(2)
             .all(|w| w[1].r_out > w[0].r_out && w[1].amplitude_over_alpha > w[0].amplitude_over_alpha));
+    }
+
+    /// A side without `"g"` (every law written before the push shape) reads as the
+    /// free arc, bit for bit, and writes back without it; `"g": "push"` gives
+    /// r∞ − c/a, its u with g = 1/a, and round-trips.
+    #[test]
+    fn the_shape_field_is_optional_and_push_is_one_over_a() {
+        let l = law();
+        let old = r#"{"form":"speed-loss","parameters":{"in":{"r_inf":0.7,"c":0.0,"cov":[[1e-4,0.0],[0.0,1e-6]]},"out":{"r_inf":1.02,"c":0.02,"cov":[[4e-4,-2e-5],[-2e-5,4e-6]]},"shared":false,"amplitude_min":0.01,"amplitude_max":0.4}}"#;
+        let read: RestitutionLaw = serde_json::from_str(old).unwrap();
+        assert_eq!(read, l);
+        for a in [1e-7, 0.003, 0.01, 0.2, 0.5, 1.0] {
+            assert_eq!(
+                read.r(Side::Outward, a).to_bits(),
+                (1.02 - 0.02 * speed_shape(a.max(1e-6))).max(0.0).to_bits()
+            );
+        }
+        assert!(!serde_json::to_string(&l).unwrap().contains("\"g\""));
+        let pushed: RestitutionLaw = serde_json::from_str(&old.replace("\"out\":{", "\"out\":{\"g\":\"push\",")).unwrap();
+        assert_eq!(pushed.parameters.outward.g, Shape::Push);
+        assert_eq!(pushed.parameters.inward.g, Shape::Free);
+        for a in [0.03, 0.1, 0.5] {
+            assert!((pushed.r(Side::Outward, a) - (1.02 - 0.02 / a)).abs() < 1e-15);
+            let u = (4e-4 + 2.0 * 2e-5 / a + 4e-6 / (a * a)).sqrt();
+            assert!((pushed.r_u(Side::Outward, a) - u).abs() < 1e-15);
+        }
+        // g(1) = 1 for both shapes; below r = 0 the push clamps as the free arc does.
+        assert_eq!(pushed.r(Side::Outward, 1.0), read.r(Side::Outward, 1.0));
+        assert_eq!(pushed.r(Side::Outward, 0.019), 0.0);
+        assert_eq!(pushed.r(Side::Inward, 0.3), 0.70);
+        let s = serde_json::to_string(&pushed).unwrap();
+        assert!(s.contains("\"g\":\"push\""), "{s}");
+        assert_eq!(serde_json::from_str::<RestitutionLaw>(&s).unwrap(), pushed);
+        // A draw keeps the shape.
+        assert_eq!(pushed.sample([0.1, 0.2, 0.3, 0.4]).parameters.outward.g, Shape::Push);
+        assert!(serde_json::from_str::<RestitutionLaw>(&old.replace("\"out\":{", "\"out\":{\"g\":\"spring\",")).is_err());
     }
 
     #[test]

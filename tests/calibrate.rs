@@ -199,6 +199,7 @@ fn law_test(
         r_inf,
         c,
         cov: [[0.0; 2]; 2],
+        g: Default::default(),
     };
     let model = RockingModel {
         alpha,

@@ -726,6 +726,7 @@ fn truth_law_fixture(fit: &rocklab::law_fit::LawFit) {
     let (a, b) = (stored.parameters, fit.law.parameters);
     for (x, y) in [(a.inward, b.inward), (a.outward, b.outward)] {
         assert!((x.r_inf - y.r_inf).abs() < 1e-9 && (x.c - y.c).abs() < 1e-9, "{x:?} vs {y:?}");
+        assert_eq!(x.g, y.g);
     }
     assert_eq!(stored.form, fit.law.form);
 }
@@ -828,6 +829,18 @@ fn holdout_law_from_readings() {
             v.iter().sum::<f64>() / v.len() as f64
         };
         let cst: Vec<f64> = listed.iter().map(|l| mean(l.2) - l.4).collect();
+        if rocking == rocklab::wall::Rocking::OneSided {
+            for s in [Side::Inward, Side::Outward] {
+                let pick = |v: &[f64]| -> Vec<f64> { listed.iter().zip(v).filter(|(l, _)| l.2 == s).map(|(_, e)| *e).collect() };
+                println!(
+                    "{name}: side {s:?} ({:?}): {} listed impacts, law RMS {:.4}, best constant {:.4}",
+                    law.side(s).g,
+                    pick(&err).len(),
+                    rms(&pick(&err)),
+                    rms(&pick(&cst))
+                );
+            }
+        }
         // Where the law misses: inside the amplitudes it was fitted on, and
         // below them (extrapolated).
         let (lo, hi) = (law.parameters.amplitude_min, law.parameters.amplitude_max);

@@ -130,11 +130,15 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
     let p = &fit.law.parameters;
     let side = |name: &str, l: &crate::restitution_law::SideLaw| {
         format!(
-            "{name}: r(a) = {:.4} (± {:.4}) − {:.5} (± {:.5}) / √(a(2 − a))",
+            "{name}: r(a) = {:.4} (± {:.4}) − {:.5} (± {:.5}) / {}",
             l.r_inf,
             l.cov[0][0].sqrt(),
             l.c,
-            l.cov[1][1].sqrt()
+            l.cov[1][1].sqrt(),
+            match l.g {
+                crate::restitution_law::Shape::Free => "√(a(2 − a))",
+                crate::restitution_law::Shape::Push => "a",
+            }
         )
     };
     let text = if p.shared {
@@ -143,8 +147,13 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         format!("{}; {}", side("in", &p.inward), side("out", &p.outward))
     };
     s.push_str(&format!(
-        "<p>Form {}: r = r∞ − c/√(a(2 − a)), a fixed loss of angular speed per impact on top of a proportional one (docs/restitution-law.md). {}. Fitted to the impacts of {} (status ok, in the means), amplitudes {:.3}–{:.3}.</p>\n",
+        "<p>Form {}: r = r∞ − c/√(a(2 − a)), a fixed loss of angular speed per impact on top of a proportional one{} (docs/restitution-law.md). {}. Fitted to the impacts of {} (status ok, in the means), amplitudes {:.3}–{:.3}.</p>\n",
         fit.law.form.as_str(),
+        if p.outward.g == crate::restitution_law::Shape::Push {
+            "; the outward side of a one-sided wall r = r∞ − c/a (its impacts end a push against the transverse walls, speed ∝ amplitude)"
+        } else {
+            ""
+        },
         escape(&text),
         escape(&fit.tests_used.join(", ")),
         p.amplitude_min,

@@ -490,7 +490,7 @@ pub fn law_end(peaks: &[ContactPeak], arc: (f64, f64), geo: &Geometry) -> Option
         } else {
             duration / first_push
         };
-        (ratio > LIFT_RATIO && p.k >= 1).then(|| {
+        (ratio > LIFT_RATIO).then(|| {
             let what = if p.k % 2 == 0 {
                 "the rigid block's free arc of its amplitude"
             } else {

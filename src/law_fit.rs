@@ -65,7 +65,8 @@
 //! carry r past 1; the law's range already holds r at its value at the smallest
 //! amplitude observed where c < 0 ([`crate::restitution_law`], "Range") and caps
 //! e = r e_H at 1, so the rise stays within the data. Two-sided walls and the
-//! outward side (free arcs ending on the base) keep the rule above.
+//! outward side (whose impacts end the push, fitted in its shape g = 1/a) keep
+//! the rule above.
 //!
 //! The incomplete beta function (for the F distribution) is Numerical Recipes §6.4
 //! (continued fraction by the modified Lentz method; ln Γ by Lanczos, §6.1): a dozen
@@ -614,7 +615,7 @@ mod tests {
     /// One-sided walls: an inward r that rises as the amplitude falls (the
     /// push into the transverse walls) is taken where the data reject the
     /// constant, held below the smallest amplitude observed, and e capped at 1;
-    /// the outward side (free arcs ending on the base) still keeps the constant
+    /// the outward side (impacts that end the push) still keeps the constant
     /// where its fitted speed loss is negative.
     #[test]
     fn a_one_sided_inward_r_rising_as_the_amplitude_falls_is_taken() {

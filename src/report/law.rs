@@ -66,26 +66,33 @@ pub fn law_figure(res: &CampaignResult, fit: &LawFit) -> Result<Figure, ReportEr
     let panels: Vec<plots::Panel> = groups
         .iter()
         .map(|(name, sides, side)| {
-            let tests: Vec<(String, Vec<(f64, f64)>)> = res
+            // Impacts a test keeps out of the law (the wall barely lifts off
+            // around them, `law_end`) are drawn as one series of their own.
+            let mut out_of_law: Vec<(f64, f64)> = Vec::new();
+            let mut tests: Vec<(String, Vec<(f64, f64)>)> = res
                 .tests
                 .iter()
                 .filter_map(|t| t.result.as_ref().ok().map(|r| (t, r)))
                 .map(|(t, r)| {
-                    let pts = r
+                    let (pts, out): (Vec<&crate::impacts::ImpactCoefficient>, Vec<_>) = r
                         .impacts
                         .impacts
                         .iter()
                         .filter(|i| sides.contains(&i.side))
-                        .map(|i| (i.amplitude_over_alpha, i.r))
-                        .collect();
+                        .partition(|i| r.law_end.as_ref().is_none_or(|(from, _)| i.k < *from));
+                    out_of_law.extend(out.iter().map(|i| (i.amplitude_over_alpha, i.r)));
+                    let pts: Vec<(f64, f64)> = pts.iter().map(|i| (i.amplitude_over_alpha, i.r)).collect();
                     let tag = if r.analysis.quality.is_ok() && !t.spec.exclude_from_mean {
                         ""
                     } else {
                         " (not fitted)"
                     };
-                    (format!("{}{tag}", t.spec.id), pts)
+                    (format!("test {}{tag}", t.spec.id), pts)
                 })
                 .collect();
+            if !out_of_law.is_empty() {
+                tests.push(("kept out of the law (barely lifts off)".to_string(), out_of_law));
+            }
             let law: Vec<(f64, f64, f64)> = curve
                 .iter()
                 .map(|p| match side {

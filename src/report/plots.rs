@@ -396,19 +396,13 @@ fn law_lines(law: &[(f64, f64, f64)], fitted: (f64, f64)) -> Vec<Series> {
 
 /// One panel of the restitution-law plot (issue 20): r of every impact against
 /// log₁₀ of its amplitude |θ|/α, one marker colour per test; the law with its ±1 u
-/// band; the constant for comparison. `tests`: (id, [(a, r)]); `law`: [(a, r, u)].
+/// band; the constant for comparison. `tests`: (legend label, [(a, r)]); `law`: [(a, r, u)].
 pub fn law_panel(title: &str, tests: &[(String, Vec<(f64, f64)>)], law: &[(f64, f64, f64)], constant: f64, fitted: (f64, f64)) -> Panel {
     let lg = |a: f64| a.max(1e-9).log10();
     let mut series: Vec<Series> = tests
         .iter()
         .enumerate()
-        .map(|(i, (id, pts))| {
-            Series::dots(
-                &format!("test {id}"),
-                PALETTE[i % PALETTE.len()],
-                pts.iter().map(|&(a, r)| (lg(a), r)).collect(),
-            )
-        })
+        .map(|(i, (id, pts))| Series::dots(id, PALETTE[i % PALETTE.len()], pts.iter().map(|&(a, r)| (lg(a), r)).collect()))
         .collect();
     // The constant first, so that the law is drawn over it: where the data do not
     // reject the constant the law is that constant and its line must still show.
@@ -453,7 +447,7 @@ mod tests {
     /// is drawn beside the constant.
     #[test]
     fn law_panel_names_a_constant_law_once() {
-        let tests = vec![("t1".to_string(), vec![(0.1, 0.9)])];
+        let tests = vec![("test t1".to_string(), vec![(0.1, 0.9)])];
         let flat = [(0.01, 0.9, 0.01), (0.3, 0.9, 0.01)];
         assert_eq!(
             labels(&law_panel("x", &tests, &flat, 0.9, (0.01, 0.3))),

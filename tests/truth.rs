@@ -191,19 +191,22 @@ fn contact_phases_from_the_campaign_only_where_it_shows_them() {
     }
 }
 
-/// A contact is not a filter, and an estimated filter is not vouched for where
-/// the campaign shows contacts and the contact reading fails its checks
-/// (docs/estimator.md). Three tests of the public-like stand-in Q2-s5 (session
-/// 14): Q2_150_1 (200 Hz), Q2_130_1 (1000 Hz) and Q2_90_1 (500 Hz) show their
-/// contact phases; Q2_110_1 (100 Hz, contacts of 14–17 ms) alone reads as an estimated 12.3 Hz
-/// Bessel whose inverse puts its peaks 2.8–8.6 % high, its values up to 1.16 pp
-/// off, and until session 14 kept that reading with status ok. Read with the
-/// wall's contacts and no filter, its residuals around impact 4 stand out
-/// (9.6 × the noise). It must be suspect, for the unknown filter; the
-/// others stay ok within 1 pp.
+/// A contact is not a filter (docs/estimator.md). Three tests of the
+/// public-like stand-in Q2-s5 (session 14): Q2_150_1 (200 Hz), Q2_130_1
+/// (1000 Hz) and Q2_90_1 (500 Hz) show their contact phases; Q2_110_1 (100 Hz,
+/// contacts of 14–17 ms) alone reads as an estimated 12.3 Hz Bessel whose
+/// inverse puts its peaks 2.8–8.6 % high, its values up to 1.16 pp off, and
+/// until session 14 kept that reading with status ok. Sessions 14–15 flagged
+/// it for the unknown filter: read with the wall's contacts and no filter, its
+/// residuals around impact 4 stood out (9.6 × the noise) and no reading
+/// vouched for the peaks next to it. Since session 16 their kink readings do
+/// (src/peaks/vouch.rs): the contact reading passes its checks, the estimated
+/// filter is dropped for it, and the test is ok within 0.5 pp. Every test of
+/// the campaign must be ok, read with contact phases and no estimated filter,
+/// within 1 pp. (The reason for an unknown filter stays covered by the
+/// compliant draw's seed 1178, tests/random_draw.rs.)
 #[test]
-fn an_estimated_filter_is_not_vouched_for_where_the_campaigns_contacts_fail() {
-    use rocklab::report::quality::{kind, split, Kind};
+fn a_contact_is_not_read_as_an_estimated_filter() {
     let name = "mujoco-public-like-two-sided-100hz";
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
@@ -213,19 +216,15 @@ fn an_estimated_filter_is_not_vouched_for_where_the_campaigns_contacts_fail() {
         let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
         let v: Vec<f64> = r.analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
         let worst = errors_pp(&v, res.campaign.e_housner, tt).iter().map(|e| e.1.abs()).fold(0.0, f64::max);
-        println!("{} [{}] {worst:.2} pp", t.spec.id, r.analysis.quality.describe());
-        if t.spec.id == "Q2_110_1" {
-            assert_eq!(r.analysis.response.source, "estimated", "the test's own reading is kept");
-            let why = r.suspect_reason().expect("suspect");
-            assert!(split(&why).into_iter().map(kind).any(|k| k == Kind::FilterUnknown), "{why}");
-            for named in ["bessel", "compliant contacts", "3 of the campaign's 4 tests", "filter = \"none\""] {
-                assert!(why.contains(named), "{why}");
-            }
-            assert!(r.impacts.impacts.len() < r.analysis.peaks.len(), "a suspect test keeps its own impacts");
-        } else {
-            assert!(r.analysis.quality.is_ok() && r.analysis.contact_phases, "{}", t.spec.id);
-            assert!(worst <= 1.0, "{}: {worst:.2} pp", t.spec.id);
-        }
+        println!(
+            "{} [{}] {worst:.2} pp, response {}",
+            t.spec.id,
+            r.analysis.quality.describe(),
+            r.analysis.response.source
+        );
+        assert!(r.analysis.quality.is_ok() && r.analysis.contact_phases, "{}", t.spec.id);
+        assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
+        assert!(worst <= 1.0, "{}: {worst:.2} pp", t.spec.id);
     }
 }
 

@@ -114,6 +114,5 @@ fn structured_unvouched(
 ) -> Option<String> {
     let flagged = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma);
     let &(k, r) = flagged.first()?;
-    let ks: Vec<usize> = flagged.iter().map(|f| f.0).collect();
-    (!vouch::vouched(peaks, &late(), &ks)).then(|| checks::structured_reason(k, r, sigma))
+    (!vouch::vouched(peaks, &late())).then(|| checks::structured_reason(k, r, sigma))
 }

@@ -18,16 +18,30 @@
 //! [`super::local::read`], where the samples rule out an instantaneous impact,
 //! otherwise the left-hand slope of a kink at the crossing,
 //! [`super::late::read_kink`]) vouch for the global fit's peaks:
-//! - every peak k of the tables has a local reading v_l ± u_l that agrees with
-//!   the global v_g ± u_g: |v_g − v_l| ≤ 2 √(u_g² + u_l²) (two combined
-//!   standard uncertainties, a 95 % interval for independent normal errors);
-//! - each peak next to an impact whose residuals stand out (peaks k and k + 1
-//!   of impact k: the arcs that end and start there) has a resolved-contact
-//!   reading that agrees so: the kink reading assumes the very instantaneous
-//!   impact that the residuals put in doubt.
+//! every peak k of the tables has a local reading v_l ± u_l (the resolved
+//! contact's where the samples give one, else the kink's) that agrees with the
+//! global v_g ± u_g: |v_g − v_l| ≤ 2 √(u_g² + u_l²) (two combined standard
+//! uncertainties, a 95 % interval for independent normal errors).
 //!
 //! A test whose global fit is wrong somewhere (H2_70_1: peak 5 read 61.8 %
 //! fast, its kink reading 10.1 % slow) keeps the reason.
+//!
+//! # A kink reading next to the impact whose residuals stand out
+//! Until the sixteenth session the peaks next to such an impact (k and k + 1)
+//! needed a resolved-contact reading: the kink reading assumes an
+//! instantaneous impact, which the residuals seemed to put in doubt. But the
+//! smooth reading is missing exactly where the samples around that impact do
+//! *not* rule out an instantaneous impact ([`super::local::read`]), and the
+//! kink's own fit stays at the noise there ([`super::late::read_kink`]): the
+//! samples' account of the impact is then the kink, and what stands out is the
+//! global fit's single contact shape per direction, which cannot follow each
+//! impact's. At 100 Hz, where a soft bedding's contacts span 1.5–3.4 samples,
+//! the smooth reading never exists and the rule could never vouch. Accepted
+//! now (measured, docs/accuracy.md): four engine-made tests 0.36–0.60 pp off
+//! became ok, none of the twelve two-sided engine campaigns has an ok test
+//! more than 0.90 pp off; the tests 2.3–3.3 pp off whose kink readings agree
+//! too (70 mm releases: their last contacts are long) stay suspect for their
+//! misfit or their contact lengths, checks that do not depend on this rule.
 //!
 //! # Not on one-sided walls
 //! There the readings are not independent where it matters: the inward
@@ -55,22 +69,15 @@ fn agrees(p: &Peak, v_l: f64, u_l: f64) -> bool {
 }
 
 /// Whether the local readings `late` (peaks 0 … n − 1) vouch for the global
-/// fit's `peaks` despite residuals that stand out around the impacts
-/// `flagged` (module docs).
-pub(super) fn vouched(peaks: &[Peak], late: &[LatePeak], flagged: &[usize]) -> bool {
-    let n = peaks.len();
-    let reading = |k: usize| late.iter().find(|p| p.k == k);
-    let every = (0..n).all(|k| {
-        reading(k)
+/// fit's `peaks` despite residuals that stand out around an impact (module
+/// docs).
+pub(super) fn vouched(peaks: &[Peak], late: &[LatePeak]) -> bool {
+    (0..peaks.len()).all(|k| {
+        late.iter()
+            .find(|p| p.k == k)
             .and_then(|p| p.smooth.or(p.kink))
             .is_some_and(|r| agrees(&peaks[k], r.velocity_mm_s, r.u_mm_s))
-    });
-    let next_to_flagged = flagged.iter().flat_map(|&k| [k, k + 1]).filter(|&k| k < n).all(|k| {
-        reading(k)
-            .and_then(|p| p.smooth)
-            .is_some_and(|r| agrees(&peaks[k], r.velocity_mm_s, r.u_mm_s))
-    });
-    every && next_to_flagged
+    })
 }
 
 #[cfg(test)]
@@ -111,15 +118,17 @@ mod tests {
             late(1, Some((61.0, 1.0)), None),
             late(2, Some((-39.0, 1.0)), Some((-30.0, 1.0))),
         ];
-        assert!(vouched(&peaks, &good, &[1]));
-        // Peak 2 next to flagged impact 1 must be read as a resolved contact.
+        assert!(vouched(&peaks, &good));
+        // A kink reading vouches where the samples give no resolved contact,
+        // and the resolved contact is taken where they give one.
         let kink_only = [good[0], good[1], late(2, None, Some((-39.0, 1.0)))];
-        assert!(!vouched(&peaks, &kink_only, &[1]));
-        assert!(vouched(&peaks, &kink_only, &[]));
+        assert!(vouched(&peaks, &kink_only));
+        let smooth_off = [good[0], good[1], late(2, Some((-50.0, 1.0)), Some((-40.0, 1.0)))];
+        assert!(!vouched(&peaks, &smooth_off));
         // A reading 10 mm/s away from 2 ± 1 disagrees.
-        let off = [good[0], good[1], late(2, Some((-50.0, 1.0)), None)];
-        assert!(!vouched(&peaks, &off, &[1]));
+        let off = [good[0], good[1], late(2, None, Some((-50.0, 1.0)))];
+        assert!(!vouched(&peaks, &off));
         // A peak without any local reading vouches for nothing.
-        assert!(!vouched(&peaks, &good[..2], &[0]));
+        assert!(!vouched(&peaks, &good[..2]));
     }
 }

@@ -101,13 +101,13 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::Misfit => Advice {
             title: "The model does not follow the log: the residuals are several times the sensor's noise.",
             look: "the displacement panel of the motion plot: where does the red fit leave the grey log?",
-            how_far: "On 200 synthetic tests with compliant contacts, the 6 flagged for this were off by 6.75 pp at the median and 10.82 pp at worst (the worst of the seven values of each test): do not use the values.",
+            how_far: "On 200 synthetic tests with compliant contacts, the 4 flagged for this were off by 6.75 pp at the median and 7.18 pp at worst (the worst of the seven values of each test): do not use the values.",
             rerun: "check the wall's geometry and hinge height in [wall], and the sensor's height; a log with drift or a moving base needs trimming.",
         },
         Kind::ImpactResiduals => Advice {
             title: "The log around an impact is not where the fit puts it.",
             look: "the displacement panel of the motion plot, zoomed on the impact named.",
-            how_far: "On 200 synthetic tests with compliant contacts, the 12 flagged for this were off by 2.33 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
+            how_far: "On 200 synthetic tests with compliant contacts, the 9 flagged for this were off by 2.20 pp at the median and 7.18 pp at worst (the worst of the seven values of each test).",
             rerun: "look for a spike or a dropout near the impact in the raw log; a higher logging rate helps.",
         },
         Kind::Disagreement => Advice {
@@ -119,13 +119,13 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::LongContact => Advice {
             title: "The contact at an impact lasts too long for an impact: the wall is not rocking freely there.",
             look: "the displacement panel of the motion plot around the impact named: a slow, rounded turn instead of a kink.",
-            how_far: "On 200 synthetic tests with compliant contacts, the 10 flagged for this were off by 3.04 pp at the median and 10.82 pp at worst (the worst of the seven values of each test).",
+            how_far: "On 200 synthetic tests with compliant contacts, the 10 flagged for this were off by 2.33 pp at the median and 7.18 pp at worst (the worst of the seven values of each test).",
             rerun: "check that the wall is free to rock (no mortar bridge or friction at the hinge); trim the log to the clean impacts.",
         },
         Kind::ContactOvershoot => Advice {
             title: "Inside a contact the fitted speed overshoots the free swing: the contact model does not fit this impact.",
             look: "the velocity panel of the motion plot at the peak named: is the blue curve above the grey one?",
-            how_far: "On 200 synthetic tests with compliant contacts, the 6 flagged for this were off by 3.04 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
+            how_far: "On 200 synthetic tests with compliant contacts, the 7 flagged for this were off by 2.78 pp at the median and 6.75 pp at worst (the worst of the seven values of each test).",
             rerun: "compare with rocklab reduce --method savgol; a higher logging rate resolves the contact.",
         },
         Kind::ZeroReadings => Advice {

@@ -106,39 +106,24 @@ fn robust_spread(r: &[f64]) -> f64 {
 
 /// Residuals around the impacts must not stand out: the samples within ±2
 /// samples of each impact's onset, by their robust spread (a single spike
-/// there does not trip it; a misplaced impact moves them all).
+/// there does not trip it; a misplaced impact moves them all). The reason
+/// names the first such impact.
 pub fn structured_near_impacts(t: &[f64], residuals: &[f64], impacts: &[f64], dt: f64, sigma: f64) -> Option<String> {
-    structured_impacts(t, residuals, impacts, dt, sigma)
-        .first()
-        .map(|&(k, r)| structured_reason(k, r, sigma))
-}
-
-/// The reason of [`structured_near_impacts`] for impact `k` whose residuals
-/// spread `r` mm.
-pub fn structured_reason(k: usize, r: f64, sigma: f64) -> String {
-    format!(
-        "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
-        r / sigma
-    )
-}
-
-/// Every impact that [`structured_near_impacts`] would name: (k, robust spread
-/// of the residuals within ±2 samples of its onset, mm), in order.
-pub fn structured_impacts(t: &[f64], residuals: &[f64], impacts: &[f64], dt: f64, sigma: f64) -> Vec<(usize, f64)> {
-    impacts
-        .iter()
-        .enumerate()
-        .filter_map(|(k, &tk)| {
-            let near: Vec<f64> = t
-                .iter()
-                .zip(residuals)
-                .filter(|(ti, _)| (**ti - tk).abs() <= 2.0 * dt)
-                .map(|(_, r)| *r)
-                .collect();
-            let r = robust_spread(&near);
-            (near.len() >= 3 && r > 8.0 * sigma).then_some((k, r))
+    impacts.iter().enumerate().find_map(|(k, &tk)| {
+        let near: Vec<f64> = t
+            .iter()
+            .zip(residuals)
+            .filter(|(ti, _)| (**ti - tk).abs() <= 2.0 * dt)
+            .map(|(_, r)| *r)
+            .collect();
+        let r = robust_spread(&near);
+        (near.len() >= 3 && r > 8.0 * sigma).then(|| {
+            format!(
+                "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
+                r / sigma
+            )
         })
-        .collect()
+    })
 }
 
 /// The local re-fit of each arc's end (a second estimate of v_k from the samples

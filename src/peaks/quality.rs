@@ -112,7 +112,6 @@ fn structured_unvouched(
     sigma: f64,
     late: &dyn Fn() -> Vec<LatePeak>,
 ) -> Option<String> {
-    let flagged = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma);
-    let &(k, r) = flagged.first()?;
-    (!vouch::vouched(peaks, &late())).then(|| checks::structured_reason(k, r, sigma))
+    let reason = checks::structured_near_impacts(&fit.tw, resid, onsets, dt, sigma)?;
+    (!vouch::vouched(peaks, &late())).then_some(reason)
 }

@@ -212,6 +212,7 @@ fn a_contact_is_not_read_as_an_estimated_filter() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let res = reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default());
+    let mut ruled_out = 0;
     for t in &res.tests {
         let r = t.result.as_ref().unwrap();
         let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
@@ -225,8 +226,21 @@ fn a_contact_is_not_read_as_an_estimated_filter() {
         );
         assert!(r.analysis.quality.is_ok() && r.analysis.contact_phases, "{}", t.spec.id);
         assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
+        // The lab stated nothing: a re-read with no filter is not "stated none".
+        assert_ne!(r.analysis.response.source, "stated none", "{}", t.spec.id);
         assert!(worst <= 1.0, "{}: {worst:.2} pp", t.spec.id);
+        if t.warnings.iter().any(|w| w.contains("instead of an estimated logger filter")) {
+            ruled_out += 1;
+            let note = r.analysis.acquisition_note.as_deref().unwrap_or_default();
+            assert!(
+                note.contains("fits the rounding of the impacts") && note.contains("no filter modelled"),
+                "{}: {note}",
+                t.spec.id
+            );
+        }
     }
+    // Q2_110_1 is the test the rule re-reads (seventeenth session's note).
+    assert!(ruled_out >= 1, "no test was re-read by the campaign rule");
 }
 
 /// A filter and failing contacts leave the test suspect (`ingest/reduce.rs`,

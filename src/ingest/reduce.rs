@@ -268,8 +268,12 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
             acquisition: crate::peaks::acquisition::Acquisition::None,
             ..t.spec.clone()
         };
-        let again = reduce_loaded(campaign, &spec, r.log.clone(), &unfiltered);
+        let estimated = estimated_filter(&r.analysis);
+        let mut again = reduce_loaded(campaign, &spec, r.log.clone(), &unfiltered);
         if fits(&again) {
+            if let Ok(n) = &mut again.result {
+                mark_filter_ruled_out(&mut n.analysis, &estimated, with, n_ok);
+            }
             t.result = again.result;
             t.warnings.push(format!(
                 "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests with status ok show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
@@ -290,17 +294,34 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
     tests
 }
 
+/// The response of a test that the campaign rule re-read with contact phases
+/// and no filter: the lab stated nothing, so its source is "not detected" (not
+/// "stated none", which the re-read's own options would give), and its note
+/// names the low-pass that was estimated and why it was dropped (as the trend
+/// rule's note does, docs/acquisition.md).
+fn mark_filter_ruled_out(analysis: &mut crate::peaks::Analysis, estimated: &str, with: usize, n_ok: usize) {
+    analysis.response.source = "not detected";
+    analysis.acquisition_note = Some(format!(
+        "a low-pass ({estimated}) fits the rounding of the impacts, but {with} of the campaign's {n_ok} tests with status ok show compliant contacts, which round an impact as a low-pass does, and read with contact phases this test passes its checks: no filter modelled"
+    ));
+}
+
+/// The low-pass an analysis was read through, named for a message.
+fn estimated_filter(analysis: &crate::peaks::Analysis) -> String {
+    match (analysis.response.filter, analysis.response.fir_cutoff_hz) {
+        (Some(f), _) => f.describe(),
+        (None, Some(fc)) => format!("linear-phase FIR, cut-off {fc:.3} Hz"),
+        _ => analysis.response.source.to_string(),
+    }
+}
+
 /// The reason of a test whose logger filter was only estimated while its
 /// campaign shows contact phases (`with` of its `n_ok` tests with status ok),
 /// and whose reading with contact phases and no filter (`contacts`, its peaks
 /// if it gave any) fails its checks (docs/estimator.md, "A contact is not a
 /// filter").
 fn neither_reading(filtered: &crate::peaks::Analysis, contacts: Option<&[crate::peaks::Peak]>, with: usize, n_ok: usize) -> String {
-    let filter = match (filtered.response.filter, filtered.response.fir_cutoff_hz) {
-        (Some(f), _) => f.describe(),
-        (None, Some(fc)) => format!("linear-phase FIR, cut-off {fc:.3} Hz"),
-        _ => filtered.response.source.to_string(),
-    };
+    let filter = estimated_filter(filtered);
     let differ = contacts.map_or(String::new(), |c| {
         let ratio = |p: &[crate::peaks::Peak], k: usize| p[k + 1].velocity_mm_s / p[k].velocity_mm_s;
         let n = filtered.peaks.len().min(c.len());

@@ -278,6 +278,15 @@ fn demo_writes_tables_and_plots() {
         let summary: Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join(c).join("summary.json")).unwrap()).unwrap();
         let fitted = &summary["restitution_law"];
         assert!(fitted.is_object(), "{c}: no law");
+        // One-sided engine walls: the pushes' peaks read by the contact model,
+        // said per test (src/peaks/inward.rs); the idealised demo: never.
+        let inward = summary["tests"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|t| t["peaks_read_by_contact_model"] == serde_json::json!([1, 3, 5]))
+            .count();
+        assert_eq!(inward, if c == "one-sided-demo" { 0 } else { 3 }, "{c}");
         sets.push(law);
         if fitted["form"] != "constant" {
             sets.push(constant);

@@ -158,7 +158,8 @@ fn two_sided_demo_within_one_point() {
 /// energy). Truth is the extreme of the sensor velocity in each half-cycle,
 /// straight from the engine. Same 1.0 pp bound as the idealised campaigns.
 ///
-/// One-sided: the worst value is 0.75 pp (r₁ of P1_90_1). Until the fifth
+/// One-sided: the worst value is 0.42 pp (r₁⁺ of P1_110_1; 0.75 pp, r₁ of
+/// P1_90_1, before the pushes' peaks were read by the contact model). Until the fifth
 /// session it was 1.135 pp (r⁺ of P1_110_1): the fitted zero of a contact fit
 /// sat 1.9 mm inside the inward side, and the last outward peak, read up to that
 /// zero, ended 12 ms before the true crossing, 6 % low. v_k is now the mean of
@@ -170,6 +171,42 @@ fn two_sided_demo_within_one_point() {
 #[test]
 fn mujoco_one_sided_within_one_point() {
     check("mujoco-public-one-sided");
+}
+
+/// The pushes' peaks of a one-sided wall read by the contact model
+/// (`src/peaks/inward.rs`, eighteenth session). On the public one-sided engine
+/// campaign three of the four tests take it (peaks 1, 3 and 5), and every table value is within 0.5 pp, the goal issue 18
+/// sets (measured 0.42 pp, r₁⁺ of P1_110_1; 0.75 pp, r₁ of P1_90_1, with the
+/// global fit's readings). The demo campaigns (instantaneous impacts, no
+/// contact phases) never take it, nor a filtered log (`daq-public-bessel-1`).
+#[test]
+fn the_pushes_peaks_are_read_by_the_contact_model() {
+    let load = |name: &str| {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+        reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default())
+    };
+    let mujoco = load("mujoco-public-one-sided");
+    for t in &mujoco.tests {
+        let r = t.result.as_ref().unwrap();
+        // P1_150_1 (200 Hz, σ 0.043 mm): the contact model fits its pushes 1 and
+        // 3 worse than the noise, so none of its peaks is replaced.
+        let want: &[usize] = if t.spec.id == "P1_150_1" { &[] } else { &[1, 3, 5] };
+        assert_eq!(r.analysis.contact_model_peaks(), want, "{}", t.spec.id);
+        assert!(
+            r.analysis.peaks.iter().all(|p| p.velocity_u_mm_s.is_some_and(|u| u > 0.0)),
+            "{}",
+            t.spec.id
+        );
+    }
+    for (k, e) in max_errors("mujoco-public-one-sided") {
+        assert!(e <= 0.5, "mujoco-public-one-sided: column {k} off by {e:.2} pp (> 0.5)");
+    }
+    for name in ["one-sided-demo", "daq-public-bessel-1"] {
+        for t in &load(name).tests {
+            let r = t.result.as_ref().unwrap();
+            assert!(r.analysis.contact_model_peaks().is_empty(), "{name} {}", t.spec.id);
+        }
+    }
 }
 
 /// The campaign rule itself: P1_150_1 is fitted with contact phases and says

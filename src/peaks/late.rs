@@ -105,7 +105,7 @@ impl LatePeak {
         match method {
             ReadingMethod::LocalExtreme => self.smooth,
             ReadingMethod::LocalKink => self.kink,
-            ReadingMethod::KinkModel => None,
+            ReadingMethod::KinkModel | ReadingMethod::ContactModel => None,
         }
     }
 }

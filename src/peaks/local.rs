@@ -88,6 +88,9 @@ pub enum ReadingMethod {
     /// an impact sharper than them: the left-hand slope of a local kink fit
     /// ([`super::late::read_kink`]).
     LocalKink,
+    /// A one-sided wall's inward peak read by the contact model of its push
+    /// into the transverse walls ([`super::inward`]).
+    ContactModel,
 }
 
 /// A local reading of one velocity peak.

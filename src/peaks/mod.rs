@@ -78,6 +78,7 @@
 pub mod acquisition;
 pub mod checks;
 mod crossings;
+pub mod inward;
 pub mod late;
 pub mod local;
 pub mod model;
@@ -288,6 +289,17 @@ impl Analysis {
 }
 
 impl Analysis {
+    /// The peaks (k) read by the contact model of a one-sided wall's push into
+    /// the transverse walls ([`inward`]).
+    pub fn contact_model_peaks(&self) -> Vec<usize> {
+        self.methods
+            .iter()
+            .enumerate()
+            .filter(|(_, &m)| m == ReadingMethod::ContactModel)
+            .map(|(k, _)| k)
+            .collect()
+    }
+
     /// Peaks `from` … `max_peaks − 1` of the log `t` read locally, each from the
     /// samples around it ([`late`]), as far as the log resolves them.
     pub fn late_peaks(&self, t: &[f64], lever_mm: f64, from: usize, max_peaks: usize) -> Vec<late::LatePeak> {
@@ -351,7 +363,12 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
     let prepared = prepare_log(t, x, opts.n_peaks)?;
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
-        Method::Segments => by_segments(t, prepared, phys, opts),
+        Method::Segments => by_segments(t, prepared, phys, opts).map(|mut a| {
+            if phys.rocking == crate::wall::Rocking::OneSided {
+                inward::read_inward_peaks(&mut a, t, phys.lever_arm_mm);
+            }
+            a
+        }),
     }
 }
 

@@ -51,6 +51,11 @@ struct Reduction<'a> {
     /// contacts' rounding, why.
     #[serde(skip_serializing_if = "Option::is_none")]
     acquisition_note: Option<&'a str>,
+    /// One-sided walls: the peaks (k) read by the contact model of the push
+    /// into the transverse walls instead of the global fit
+    /// ([`crate::peaks::inward`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    peaks_read_by_contact_model: Vec<usize>,
 }
 
 /// One entry of a test's `"impacts"`: the analysis' impact (time, side entered,
@@ -177,6 +182,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 impacts_end: r.impacts.end.as_deref(),
                 acquisition: &r.analysis.response,
                 acquisition_note: r.analysis.acquisition_note.as_deref(),
+                peaks_read_by_contact_model: r.analysis.contact_model_peaks(),
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }

@@ -117,7 +117,7 @@ pub enum Method {
 impl Method {
     pub fn describe(&self) -> String {
         match self {
-            Method::Segments => "global fit of the small-angle free-rocking solution (Eq. 1; lossy inward arcs, contact phases where the log or its campaign shows them), each peak the extreme of the fitted velocity in its half-cycle, with plausibility checks".into(),
+            Method::Segments => "global fit of the small-angle free-rocking solution (Eq. 1; lossy inward arcs, contact phases where the log or its campaign shows them), each peak the extreme of the fitted velocity in its half-cycle (one-sided walls with compliant contacts: the pushes' peaks read by the contact model where it fits every push), with plausibility checks".into(),
             Method::SavGol(s) => format!("Savitzky–Golay derivative (window {}, order {}) and peak picking", s.window(), s.order()),
         }
     }

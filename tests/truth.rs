@@ -173,18 +173,20 @@ fn mujoco_one_sided_within_one_point() {
     check("mujoco-public-one-sided");
 }
 
+/// A shipped campaign reduced with the default estimator.
+fn load(name: &str) -> rocklab::reduce::CampaignResult {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default())
+}
+
 /// The pushes' peaks of a one-sided wall read by the contact model
 /// (`src/peaks/inward.rs`, eighteenth session). On the public one-sided engine
-/// campaign three of the four tests take it (peaks 1, 3 and 5), and every table value is within 0.5 pp, the goal issue 18
-/// sets (measured 0.42 pp, r₁⁺ of P1_110_1; 0.75 pp, r₁ of P1_90_1, with the
+/// campaign three of the four tests take it (peaks 1, 3 and 5), and every table
+/// value is within 0.5 pp, the goal issue 18 sets (measured 0.42 pp, r₁⁺ of P1_110_1; 0.75 pp, r₁ of P1_90_1, with the
 /// global fit's readings). The demo campaigns (instantaneous impacts, no
 /// contact phases) never take it, nor a filtered log (`daq-public-bessel-1`).
 #[test]
 fn the_pushes_peaks_are_read_by_the_contact_model() {
-    let load = |name: &str| {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-        reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default())
-    };
     let mujoco = load("mujoco-public-one-sided");
     for t in &mujoco.tests {
         let r = t.result.as_ref().unwrap();
@@ -213,10 +215,6 @@ fn the_pushes_peaks_are_read_by_the_contact_model() {
 /// why; the demo campaigns (instantaneous impacts) never take them.
 #[test]
 fn contact_phases_from_the_campaign_only_where_it_shows_them() {
-    let load = |name: &str| {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-        reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default())
-    };
     let mujoco = load("mujoco-public-one-sided");
     let t = mujoco.tests.iter().find(|t| t.spec.id == "P1_150_1").unwrap();
     assert!(t.result.as_ref().unwrap().analysis.contact_phases);

@@ -113,7 +113,9 @@ fn replacements(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> 
 fn apply(a: &mut Analysis, new: &[Replacement]) {
     for r in new {
         let p = &mut a.peaks[r.k];
-        let scale = r.u_mm_s / p.velocity_u_mm_s.unwrap_or(r.u_mm_s);
+        // A global u of 0 has no correlations to keep: the row and column
+        // become the new reading's own variance.
+        let scale = p.velocity_u_mm_s.filter(|&u| u > 0.0).map(|u| r.u_mm_s / u);
         p.time_s = r.time_s;
         p.velocity_mm_s = r.velocity_mm_s;
         p.velocity_u_mm_s = Some(r.u_mm_s);
@@ -121,11 +123,22 @@ fn apply(a: &mut Analysis, new: &[Replacement]) {
             *m = ReadingMethod::ContactModel;
         }
         if let Some(cov) = a.peak_covariance.as_mut() {
-            for row in cov.iter_mut() {
-                row[r.k] *= scale;
-            }
-            for v in cov[r.k].iter_mut() {
-                *v *= scale;
+            match scale {
+                Some(s) => {
+                    for row in cov.iter_mut() {
+                        row[r.k] *= s;
+                    }
+                    for v in cov[r.k].iter_mut() {
+                        *v *= s;
+                    }
+                }
+                None => {
+                    for row in cov.iter_mut() {
+                        row[r.k] = 0.0;
+                    }
+                    cov[r.k].iter_mut().for_each(|v| *v = 0.0);
+                    cov[r.k][r.k] = r.u_mm_s * r.u_mm_s;
+                }
             }
         }
     }
@@ -218,6 +231,23 @@ mod tests {
         assert!((cov[0][1] / (5.0 * u1) - 0.5).abs() < 1e-12);
         assert_eq!(a.methods[1], ReadingMethod::ContactModel);
         assert_eq!(a.methods[2], ReadingMethod::KinkModel);
+    }
+
+    /// A global u of 0 (never stated so, but not a division by zero): the
+    /// replaced peak's row and column hold only its own variance.
+    #[test]
+    fn a_zero_global_u_gives_the_reading_its_own_variance() {
+        let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
+        let mut a = analysis(&v, 5.0);
+        a.peaks[1].velocity_u_mm_s = Some(0.0);
+        let read = [reading(1, 400.0, 2.0, 50.0), reading(3, 300.0, 1.0, 50.0), reading(5, 220.0, 1.0, 50.0)];
+        let new = replacements(&a, &read).expect("replaced");
+        apply(&mut a, &new);
+        let cov = a.peak_covariance.as_ref().unwrap();
+        assert_eq!(a.peaks[1].velocity_u_mm_s, Some(2.0));
+        assert_eq!(cov[1][1], 4.0);
+        assert!((0..6).filter(|&j| j != 1).all(|j| cov[1][j] == 0.0 && cov[j][1] == 0.0));
+        assert!(cov.iter().flatten().all(|x| x.is_finite()));
     }
 
     /// One odd peak not at the noise, a wall gaining energy, or a filter in

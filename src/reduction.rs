@@ -138,7 +138,12 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
             let contacts = arc_contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S);
             extend_late_two_sided(&mut table, &late, &contacts, e_housner, &geo, Some(arc));
         } else {
-            let contacts = contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S);
+            // Read once: the pushes' rule (`peaks::inward`) read them with the
+            // same arc (the fit's own), peaks and window where it ran.
+            let contacts = match red.analysis.contact_readings.take() {
+                Some(c) => c,
+                None => contact_peaks(&red.analysis, &red.log.time_s, phys.lever_arm_mm, arc, MAX_IMPACT_PEAKS, CONTACT_POST_S),
+            };
             extend_late_contacts(&mut table, &contacts, e_housner, &geo, Some(arc));
             reread_contacts(&mut table, &contacts, n, e_housner, &geo);
             red.law_end = law_end(&contacts, arc, &geo).filter(|(k, _)| *k < table.impacts.len());
@@ -165,4 +170,14 @@ pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analys
     let ok: Vec<&Analysis> = analyses.into_iter().filter(|a| a.quality.is_ok()).collect();
     let with = ok.iter().filter(|a| a.contact_phases).count();
     (ok.len() >= 2 && 2 * with > ok.len()).then_some((with, ok.len()))
+}
+
+#[cfg(test)]
+mod tests {
+    /// The per-impact table reuses the pushes' rule's contact readings
+    /// (`Analysis::contact_readings`) only because both read the same peaks.
+    #[test]
+    fn the_pushes_rule_reads_as_many_peaks_as_the_impact_table() {
+        assert_eq!(crate::peaks::inward::PEAKS_READ, super::MAX_IMPACT_PEAKS);
+    }
 }

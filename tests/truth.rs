@@ -182,8 +182,8 @@ fn load(name: &str) -> rocklab::reduce::CampaignResult {
 /// The pushes' peaks of a one-sided wall read by the contact model
 /// (`src/peaks/inward.rs`, eighteenth session). On the public one-sided engine
 /// campaign three of the four tests take it (peaks 1, 3 and 5), and every table
-/// value is within 0.5 pp, the goal issue 18 sets (measured 0.42 pp, r₁⁺ of P1_110_1; 0.75 pp, r₁ of P1_90_1, with the
-/// global fit's readings). The demo campaigns (instantaneous impacts, no
+/// value is within 0.5 pp, the goal issue 18 sets (measured 0.42 pp, r₁⁺ of
+/// P1_110_1; 0.75 pp, r₁ of P1_90_1, with the global fit's readings). The demo campaigns (instantaneous impacts, no
 /// contact phases) never take it, nor a filtered log (`daq-public-bessel-1`).
 #[test]
 fn the_pushes_peaks_are_read_by_the_contact_model() {

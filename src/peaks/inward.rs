@@ -43,8 +43,9 @@ use super::{Analysis, ReadingMethod};
 
 /// The most peaks read (as [`crate::reduction::MAX_IMPACT_PEAKS`]): the
 /// restraint's (λ, ω) is fitted over every push the log resolves, so the
-/// readings are those of the per-impact table.
-const PEAKS_READ: usize = 12;
+/// readings are those of the per-impact table, which reuses them
+/// ([`Analysis::contact_readings`]).
+pub(crate) const PEAKS_READ: usize = 12;
 
 /// Replace the odd peaks of a one-sided analysis by their contact readings
 /// (module docs). Returns whether it did. The caller decides that the wall is
@@ -57,7 +58,9 @@ pub fn read_inward_peaks(a: &mut Analysis, t: &[f64], lever_mm: f64) -> bool {
     }
     let Some(arc) = a.small_arc else { return false };
     let read = contact_peaks(a, t, lever_mm, arc, PEAKS_READ, CONTACT_POST_S);
-    let Some(new) = replacements(a, &read) else { return false };
+    let new = replacements(a, &read);
+    a.contact_readings = Some(read);
+    let Some(new) = new else { return false };
     apply(a, &new);
     true
 }
@@ -188,6 +191,7 @@ mod tests {
                 fir_cutoff_hz: None,
             },
             acquisition_note: None,
+            contact_readings: None,
         }
     }
 

@@ -251,6 +251,10 @@ pub struct Analysis {
     /// rounding widens as the wall slows (its contacts'), why: the report says
     /// so beside "not detected".
     pub acquisition_note: Option<String>,
+    /// The contact model's readings of a one-sided log's peaks 1 … 11
+    /// ([`late::contact_peaks`]), where [`inward`] read them; the per-impact
+    /// table takes them from here instead of reading them again.
+    pub contact_readings: Option<Vec<late::ContactPeak>>,
 }
 
 pub use local::ReadingMethod;
@@ -462,6 +466,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
             fir_cutoff_hz: None,
         },
         acquisition_note: None,
+        contact_readings: None,
     }
 }
 
@@ -592,5 +597,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         methods,
         response,
         acquisition_note: fit.filter_dropped.clone(),
+        contact_readings: None,
     })
 }

@@ -65,8 +65,10 @@ pub(super) fn plausibility(
     let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
     let onsets: Vec<f64> = (0..m.m()).map(|k| if is_local(k) { f64::NAN } else { m.onset(k) }).collect();
     let resid = fit.residuals();
-    // Impacts 0..n−2: the ones between the peaks the tables use.
-    let after: Vec<Option<f64>> = (0..v.len().saturating_sub(1)).map(|k| m.speeds(k).1).collect();
+    // Impacts 0..n−1: the ones that end the peaks the tables use, the last
+    // one's included (it ends peak n−1: an exit that gains speed there has
+    // that peak's time wrong, docs/estimator.md).
+    let after: Vec<Option<f64>> = (0..v.len().min(m.m())).map(|k| m.speeds(k).1).collect();
     let reasons: Vec<String> = [
         checks::merged_impacts(&zeros, dt),
         checks::alternation(&v),

@@ -470,6 +470,35 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
     }
 }
 
+/// [`checks::kink_disagreement`] on a one-sided fit with contact phases and no
+/// filter in its model: the ends of the free arcs (peaks k even) against the
+/// log's slope into their crossings ([`late::read_late`]'s kink readings).
+fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, peaks: &[Peak], n_peaks: usize) -> Option<String> {
+    let m = fit.model();
+    if phys.rocking != Rocking::OneSided || !fit.contacts || m.filter.is_some() || fit.estimated.is_some() {
+        return None;
+    }
+    let inp = late::LateInput {
+        t,
+        x: &p.x,
+        lever_mm: phys.lever_arm_mm,
+        sigma: p.sigma,
+        dt: p.dt,
+        release_s: m.release_time(),
+        crossings: &p.crossings,
+    };
+    let read = late::read_late(&inp, 0);
+    let kink: Vec<Option<(f64, f64)>> = (0..n_peaks.min(peaks.len()))
+        .map(|k| {
+            let q = read.iter().find(|q| q.k == k && k % 2 == 0)?.kink?;
+            Some((q.velocity_mm_s, q.u_mm_s))
+        })
+        .collect();
+    let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
+    let u: Vec<f64> = peaks.iter().map(|p| p.velocity_u_mm_s.unwrap_or(0.0)).collect();
+    checks::kink_disagreement(&v, &u, &kink)
+}
+
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
@@ -566,6 +595,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     };
     let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
+    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):
     // a peak read from the global fit that depends on parameters the log does
     // not determine, or a covariance that is not one.

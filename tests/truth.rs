@@ -283,10 +283,12 @@ fn an_exit_that_gains_speed_at_the_last_table_peak_is_flagged() {
 /// r⁻ 1.58 pp off at u 0.02 pp. Until the nineteenth session that was ok. The
 /// log's slope into the crossing reads v₄ −2.1 ± 1.3 %, and the two readings
 /// now disagree beyond 4 combined u + 3 % (`checks::kink_disagreement`): the
-/// test is suspect. The other five stay ok. Not caught (docs/accuracy.md):
-/// H1_140_2, read alone through an estimated FIR (its contacts taken for a
-/// filter, where this check does not run), is ok with r⁻ 1.68 pp off at u
-/// 0.45 pp (3.7 u); the four others are within 1.4 u (0.84–1.22 pp).
+/// test is suspect. H1_140_2 (200 Hz in the fixture) is read through an
+/// estimated linear-phase FIR at 35.8 Hz (its contacts taken for a filter):
+/// its free arcs' ends +4.4 and +10.3 % against slopes of −5.8 and −4.7 %,
+/// r⁻ 1.68 pp off at u 0.45 pp until the check ran through an estimated
+/// FIR too; it is suspect for peak 4. The four others stay ok, within
+/// 1.4 u (0.84–1.22 pp).
 #[test]
 fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
     use rocklab::peaks::analyse;
@@ -304,9 +306,9 @@ fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
         let a = analyse(&t, &x, &physics(&campaign, spec), &PeakOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", spec.id));
         let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == spec.id.as_str()).unwrap();
         println!("{} at 100 Hz: [{}]", spec.id, a.quality.describe());
-        if spec.id == "H1_160_2" {
+        if spec.id == "H1_160_2" || spec.id == "H1_140_2" {
             let rocklab::peaks::Quality::Suspect(why) = &a.quality else {
-                panic!("H1_160_2 at 100 Hz is ok: {:?}", a.peaks)
+                panic!("{} at 100 Hz is ok: {:?}", spec.id, a.peaks)
             };
             assert!(
                 why.iter()

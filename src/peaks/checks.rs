@@ -16,7 +16,7 @@
 //! | [`undetermined_parameters`] | a peak read from the global fit depends on a direction of its parameters that the log does not determine and does not bound (its uncertainty cannot be computed) |
 //! | [`not_a_covariance`] | the peaks' covariance is not finite, symmetric and positive semi-definite with a positive variance for every peak |
 //! | [`disagreement`] | the local re-fit of an arc's end disagrees with the global fit by more than 4 combined standard uncertainties + 3 % |
-//! | [`kink_disagreement`] | one-sided, contact phases, no filter: the log's slope into the crossing that ends a free arc disagrees with the global fit's peak as [`disagreement`] |
+//! | [`kink_disagreement`] | one-sided, contact phases and no filter, or an estimated FIR: the log's slope into the crossing that ends a free arc disagrees with the global fit's peak as [`disagreement`] |
 //!
 //! The thresholds were set on the random draws of `tests/random_draw.rs`: a
 //! large release (0.6–0.7 α) on very quiet logs (σ ≈ 0.006 mm) leaves a misfit
@@ -133,7 +133,8 @@ pub fn disagreement(v: &[f64], u: &[f64], local: &[Option<(f64, f64)>]) -> Optio
     disagree_with(v, u, local, "a local fit of its half-cycle")
 }
 
-/// One-sided walls with contact phases: the end of a free arc (k even) read
+/// One-sided walls with contact phases (or read through an estimated FIR,
+/// `peaks::free_arc_ends_disagree`): the end of a free arc (k even) read
 /// by the global fit against the log's slope into its crossing
 /// ([`super::late::read_kink`], `kink[k]`), with the tolerance of
 /// [`disagreement`]. Where the compliant contact that ends the arc spans a

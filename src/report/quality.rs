@@ -113,7 +113,7 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::Disagreement => Advice {
             title: "Two ways of reading a peak disagree: the whole-record fit and a fit of that half-cycle alone, or the log's slope into its crossing.",
             look: "the velocity panel of the motion plot at the peak named: does the blue fit follow the grey velocity into the impact?",
-            how_far: "No test of the random draws tripped it. The reason gives both readings: the peak may lie anywhere between them, and the ratios that use it move with it. A one-sided engine-made wall logged at 100 Hz, the one test found, had its free arcs' ends read 2–10 % high and r⁻ 1.58 pp off (docs/accuracy.md).",
+            how_far: "No test of the random draws tripped it. The reason gives both readings: the peak may lie anywhere between them, and the ratios that use it move with it. On a one-sided engine-made wall logged at 100 Hz, the two tests found (one read through an estimated FIR) had their free arcs' ends read 2–10 % high and r⁻ 1.58 and 1.68 pp off (docs/accuracy.md).",
             rerun: "compare with rocklab reduce --method savgol; a higher logging rate narrows the disagreement.",
         },
         Kind::LongContact => Advice {

@@ -90,13 +90,13 @@ pub fn advice(kind: Kind) -> Advice {
             title: "A velocity peak is faster than the one before: a free-rocking wall cannot gain energy.",
             look: "the velocity panel of the motion plot, at the peak named, and the ratios plot (a ratio above 1).",
             how_far: "Not measured on the random draws (no test tripped it). The ratio across that peak comes out above 1, which no impact gives: do not use the values that involve it.",
-            rerun: "check that nothing pushed the wall during the test; re-run with `--method savgol` to compare.",
+            rerun: "check that nothing pushed the wall during the test; re-run with rocklab reduce --method savgol to compare.",
         },
         Kind::ImpactGainsSpeed => Advice {
             title: "An impact leaves the wall faster than it found it (e > 1): the fit has the impact's time wrong.",
             look: "the displacement panel of the motion plot around the impact named: a rounded, slow contact.",
             how_far: "No test of the random draws tripped it. A one-sided engine-made wall logged at 100 Hz and reduced alone, the one test found, was 3.73 pp off (r₁, with its peaks up to 12 % off); read with its campaign's contact phases, 1.04 pp (docs/accuracy.md).",
-            rerun: "a higher logging rate resolves the contact; at the same rate compare with `--method savgol`.",
+            rerun: "a higher logging rate resolves the contact; at the same rate compare with rocklab reduce --method savgol.",
         },
         Kind::Misfit => Advice {
             title: "The model does not follow the log: the residuals are several times the sensor's noise.",

@@ -470,6 +470,21 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
     }
 }
 
+/// Peaks 0 … `n_peaks` − 1 of the prepared log read locally ([`late::read_late`]:
+/// the smooth extreme and the kink at each crossing), from the fit's release.
+fn late_readings(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, n_peaks: usize) -> Vec<late::LatePeak> {
+    let inp = late::LateInput {
+        t,
+        x: &p.x,
+        lever_mm: phys.lever_arm_mm,
+        sigma: p.sigma,
+        dt: p.dt,
+        release_s: fit.model().release_time(),
+        crossings: &p.crossings,
+    };
+    late::read_late(&inp, 0).into_iter().take(n_peaks).collect()
+}
+
 /// [`checks::kink_disagreement`] on a one-sided fit with contact phases and no
 /// filter in its model, or read through an estimated linear-phase FIR: the
 /// ends of the free arcs (peaks k even) against the log's slope into their
@@ -486,16 +501,7 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
     if phys.rocking != Rocking::OneSided || !(unfiltered_contacts || estimated_fir) {
         return None;
     }
-    let inp = late::LateInput {
-        t,
-        x: &p.x,
-        lever_mm: phys.lever_arm_mm,
-        sigma: p.sigma,
-        dt: p.dt,
-        release_s: m.release_time(),
-        crossings: &p.crossings,
-    };
-    let read = late::read_late(&inp, 0);
+    let read = late_readings(t, p, phys, fit, n_peaks);
     let kink: Vec<Option<(f64, f64)>> = (0..n_peaks.min(peaks.len()))
         .map(|k| {
             let q = read.iter().find(|q| q.k == k && k % 2 == 0)?.kink?;
@@ -585,21 +591,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         if phys.rocking == Rocking::OneSided {
             return Vec::new();
         }
-        late::read_late(
-            &late::LateInput {
-                t,
-                x: &p.x,
-                lever_mm: phys.lever_arm_mm,
-                sigma: p.sigma,
-                dt: p.dt,
-                release_s: fit.model().release_time(),
-                crossings: &p.crossings,
-            },
-            0,
-        )
-        .into_iter()
-        .take(n_peaks)
-        .collect()
+        late_readings(t, &p, phys, &fit, n_peaks)
     };
     let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);

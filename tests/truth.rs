@@ -803,8 +803,10 @@ fn summary_of(name: &str, rep: &[(String, f64, bool, Vec<f64>)]) -> (usize, f64,
 /// its peak 5 read 61.8 % fast by the global fit and 10.1 % slow locally), the
 /// ok ones within 0.58 pp (H2_110_2's residuals around impact 4 are vouched
 /// for by its local readings, `src/peaks/vouch.rs`); one-sided, 1 of 6
-/// flagged (H1_140_1, 1.66 pp off: the rule is two-sided only), the ok ones
-/// within 1.18 pp (H1_150_1, 100 Hz; 1.24 pp, H1_140_2, before the
+/// flagged (H1_140_1, 1.66 pp off: the rule is two-sided only; ok since the
+/// twentieth session, 1.19 pp off at 1.16 u, its residuals standing out
+/// around an exit only, `a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios`),
+/// the ok ones within 1.18 pp (H1_150_1, 100 Hz; 1.24 pp, H1_140_2, before the
 /// restraint's damping was started again: the outward peaks v₁, v₃ 2–3.7 %
 /// low); 100 % of the ok tests' peaks within 2 stated u on both.
 /// This test guards what holds (the two-sided campaign meets the issue's
@@ -829,14 +831,47 @@ fn mujoco_holdouts_reduced_or_flagged() {
     assert!(h.2 && h.1 <= 1.0, "H1_140_2: ok {}, {:.2} pp off", h.2, h.1);
 }
 
+/// A one-sided test whose residuals stand out around exit impacts only
+/// (`peaks::exits_only_misfit`): the hold-out's H1_140_1, around impact 5 at
+/// 12.4 σ. Until the twentieth session it was suspect for them; its values
+/// were then 1.66 pp off (r₁, before the pushes' peaks were read by the
+/// contact model) and, with the flag withdrawn and the model-form terms kept
+/// fully correlated, 1.19 pp off at 2.3 u (r⁻: v₄ reads +4.4 % and v₂ +0.1 %,
+/// while the correlated term said their errors cancel). Now it is ok, its
+/// model-form terms carried uncorrelated, and every table value must cover
+/// its error within 2 u (measured: r⁻ +1.19 pp at u 1.03); the test fails
+/// with the term correlated. The other five keep their status.
+#[test]
+fn a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios() {
+    let name = "mujoco-holdout-one-sided";
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let res = reduce_campaign(load_campaign(name, false), PeakOptions::default());
+    for t in &res.tests {
+        let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
+        assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
+        let (c, u) = (
+            serde_json::to_value(r.coefficients).unwrap(),
+            serde_json::to_value(r.uncertainty.expect("u")).unwrap(),
+        );
+        for key in ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"] {
+            let err = (c[key].as_f64().unwrap() - tt[key].as_f64().unwrap()).abs();
+            let u = u[key].as_f64().unwrap();
+            assert!(err <= 2.0 * u, "{} {key}: {:.2} pp off at u {:.2} pp", t.spec.id, 100.0 * err, 100.0 * u);
+        }
+    }
+}
+
 /// The issue's criterion on both hold-out campaigns: at most one test flagged
 /// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
 /// within 2 u. Fails today on the one-sided campaign (see
-/// `mujoco_holdouts_reduced_or_flagged`): r₁ = v₁/v₀ of H1_150_1 (100 Hz),
+/// `mujoco_holdouts_reduced_or_flagged`): r⁻ of H1_140_1 (1.19 pp) and
+/// r₁ = v₁/v₀ of H1_150_1 (100 Hz, 1.18 pp),
 /// where the wall leaves the transverse walls (docs/accuracy.md,
 /// "One-sided: the exit from the inward side, and the restraint's amplitude").
 #[test]
-#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.18 pp"]
+#[ignore = "issue 18's criterion on the hold-outs, not met yet: one-sided ok tests up to 1.19 pp"]
 fn holdouts_meet_the_issue() {
     for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
         let (flagged, worst, within) = holdout_summary(name);

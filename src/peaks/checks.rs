@@ -9,7 +9,7 @@
 //! | [`energy_gain`] | a peak is faster than the one before by more than 2 % + 3 u (free rocking only loses energy) |
 //! | [`impact_gains_speed`] | the speed after an impact exceeds the speed before it by more than 3 u (e > 1) |
 //! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise |
-//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`) |
+//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`); not on a one-sided fit with contact phases and no filter where they stand out around exit impacts only (`peaks::exits_only_misfit`) |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |
 //! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 % |
@@ -108,23 +108,33 @@ fn robust_spread(r: &[f64]) -> f64 {
 /// Residuals around the impacts must not stand out: the samples within ±2
 /// samples of each impact's onset, by their robust spread (a single spike
 /// there does not trip it; a misplaced impact moves them all). The reason
-/// names the first such impact.
+/// names the first such impact ([`structured_impacts`]).
 pub fn structured_near_impacts(t: &[f64], residuals: &[f64], impacts: &[f64], dt: f64, sigma: f64) -> Option<String> {
-    impacts.iter().enumerate().find_map(|(k, &tk)| {
-        let near: Vec<f64> = t
-            .iter()
-            .zip(residuals)
-            .filter(|(ti, _)| (**ti - tk).abs() <= 2.0 * dt)
-            .map(|(_, r)| *r)
-            .collect();
-        let r = robust_spread(&near);
-        (near.len() >= 3 && r > 8.0 * sigma).then(|| {
-            format!(
-                "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
-                r / sigma
-            )
-        })
+    structured_impacts(t, residuals, impacts, dt, sigma).first().map(|&(k, r)| {
+        format!(
+            "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
+            r / sigma
+        )
     })
+}
+
+/// Every impact k whose residuals stand out (at least 3 samples within ±2
+/// samples of its onset, robust spread above 8 σ), with that spread (mm).
+pub fn structured_impacts(t: &[f64], residuals: &[f64], impacts: &[f64], dt: f64, sigma: f64) -> Vec<(usize, f64)> {
+    impacts
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &tk)| {
+            let near: Vec<f64> = t
+                .iter()
+                .zip(residuals)
+                .filter(|(ti, _)| (**ti - tk).abs() <= 2.0 * dt)
+                .map(|(_, r)| *r)
+                .collect();
+            let r = robust_spread(&near);
+            (near.len() >= 3 && r > 8.0 * sigma).then_some((k, r))
+        })
+        .collect()
 }
 
 /// The local re-fit of each arc's end (a second estimate of v_k from the samples
@@ -365,6 +375,14 @@ mod tests {
             *v = 0.2;
         }
         assert!(structured_near_impacts(&t, &r, &[0.5], 0.01, 0.01).unwrap().contains("impact 0"));
+        // Every impact that stands out is listed, not only the first.
+        assert_eq!(
+            structured_impacts(&t, &r, &[0.5, 0.2, 0.5], 0.01, 0.01)
+                .iter()
+                .map(|x| x.0)
+                .collect::<Vec<_>>(),
+            vec![0, 2]
+        );
     }
 
     #[test]

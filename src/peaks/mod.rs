@@ -516,6 +516,33 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
+/// A one-sided fit with contact phases, seen through no logger filter, whose
+/// residuals stand out around exit impacts only (k odd: the crossings where
+/// the wall leaves the transverse walls, [`checks::structured_impacts`]).
+///
+/// There the engine's wall leaves the restraint across θ = 0 without a jump
+/// in speed, only its curvature changing sign (docs/accuracy.md, "One-sided:
+/// why v₁ and v₃ read 2–3.7 % low"); the model's impact with a contact phase
+/// cannot follow that shape, and its residuals stand out at 8.5–14.7 σ on
+/// tests whose values are within 0.2–1.1 pp of the truth. Re-fitted with the
+/// samples of that contact left out, no peak of those tests moves by more than
+/// 0.3 of its u (nine tests, twentieth session): the peaks are not read from
+/// there. Such a fit is not suspect for those residuals; its model-form terms
+/// are carried uncorrelated instead
+/// ([`uncertainty::add_model_spread_independent`]), since a model known to
+/// miss the log cannot be trusted to make the same error at every peak.
+/// Residuals that stand out around an entry (k even) keep their reason.
+fn exits_only_misfit(fit: &SegmentFit, response: &acquisition::ResponseUsed, phys: &Physics, dt: f64, sigma: f64) -> bool {
+    let m = fit.model();
+    if phys.rocking != Rocking::OneSided || !fit.contacts || fit.estimated.is_some() || response.filter.is_some() || response.fir_cutoff_hz.is_some()
+    {
+        return false;
+    }
+    let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
+    let standing_out = checks::structured_impacts(&fit.tw, &fit.residuals(), &onsets, dt, sigma);
+    !standing_out.is_empty() && standing_out.iter().all(|(k, _)| k % 2 == 1)
+}
+
 fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
     let n_peaks = opts.n_peaks;
     let (filter, mut response) = acquisition::stated(&opts.acquisition);
@@ -541,6 +568,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Each peak's two readings of where its half-cycle ends (zero without
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
+    let exits_misfit = exits_only_misfit(&fit, &response, phys, p.dt, p.sigma);
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
     let cov = peak_cov.map(|pc| {
@@ -552,11 +580,18 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         if !fit.contacts {
             uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
         }
+        // Where the model misses the log at exits, its model-form terms are
+        // not taken to cancel in the ratios (`exits_only_misfit`).
+        let model_spread = if exits_misfit {
+            uncertainty::add_model_spread_independent
+        } else {
+            uncertainty::add_model_spread
+        };
         if let Some(alt) = &fit.alternative {
-            uncertainty::add_model_spread(&mut c, &impacts, alt);
+            model_spread(&mut c, &impacts, alt);
         }
         if let Some(alt) = &fit.rival_minimum {
-            uncertainty::add_model_spread(&mut c, &impacts, alt);
+            model_spread(&mut c, &impacts, alt);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
         if let Some((est, cutoff)) = &fit.estimated {
@@ -593,7 +628,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         }
         late_readings(t, &p, phys, &fit, n_peaks)
     };
-    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, p.dt, p.sigma, &late);
+    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, (p.dt, p.sigma), exits_misfit, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):

@@ -39,7 +39,8 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 ///
 /// Residuals that stand out around an impact are a reason only where the
 /// local readings of the peaks (`late`, computed only then) do not vouch for
-/// the global fit's ([`vouch`]).
+/// the global fit's ([`vouch`]), and not where they stand out around a
+/// one-sided wall's exits only (`exits_misfit`, `super::exits_only_misfit`).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn plausibility(
     fit: &SegmentFit,
@@ -47,8 +48,8 @@ pub(super) fn plausibility(
     local: &[Option<(f64, f64)>],
     spread: &[f64],
     methods: &[ReadingMethod],
-    dt: f64,
-    sigma: f64,
+    (dt, sigma): (f64, f64),
+    exits_misfit: bool,
     late: &dyn Fn() -> Vec<LatePeak>,
 ) -> Quality {
     let is_local = |k: usize| methods.get(k) == Some(&ReadingMethod::LocalExtreme);
@@ -75,7 +76,11 @@ pub(super) fn plausibility(
         checks::energy_gain(&v, &u),
         checks::impact_gains_speed(&v, &after, &u),
         checks::misfit(&resid, sigma),
-        structured_unvouched(fit, &resid, &onsets, peaks, dt, sigma, late),
+        if exits_misfit {
+            None
+        } else {
+            structured_unvouched(fit, &resid, &onsets, peaks, dt, sigma, late)
+        },
         checks::disagreement(&v_onset, &u, &local),
         m.contact_windows().and_then(|windows| {
             let windows: Vec<(f64, f64)> = windows

@@ -50,8 +50,11 @@
 //! global fit and the local readings of v₁ and v₃ are low alike (2–3.7 % on
 //! the engine's one-sided hold-out, docs/accuracy.md). Agreement then vouches
 //! for nothing: on that hold-out the rule withdrew the reason of H1_140_1,
-//! whose values are 1.66 pp off, while its v₁ was 2.6 u off. A one-sided
-//! test whose residuals stand out stays suspect.
+//! whose values are 1.66 pp off, while its v₁ was 2.6 u off. On a one-sided
+//! wall, residuals that stand out around its exit impacts only are no reason
+//! (`super::exits_only_misfit`, which carries the fit's model-form terms
+//! uncorrelated instead); elsewhere a one-sided test whose residuals stand out
+//! stays suspect.
 //!
 //! No crate does this: it compares readings of this crate's own estimators.
 

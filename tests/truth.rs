@@ -850,6 +850,11 @@ fn a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios() {
     for t in &res.tests {
         let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
         assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        if t.spec.id == "H1_140_1" {
+            // The report and summary.json say what the fit misses and what was done.
+            let note = r.analysis.model_note.as_deref().unwrap_or_default();
+            assert!(note.contains("impact 5") && note.contains("uncorrelated"), "{note}");
+        }
         let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
         let (c, u) = (
             serde_json::to_value(r.coefficients).unwrap(),

@@ -192,6 +192,7 @@ mod tests {
             },
             acquisition_note: None,
             contact_readings: None,
+            model_note: None,
         }
     }
 

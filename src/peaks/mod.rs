@@ -255,6 +255,10 @@ pub struct Analysis {
     /// ([`late::contact_peaks`]), where [`inward`] read them; the per-impact
     /// table takes them from here instead of reading them again.
     pub contact_readings: Option<Vec<late::ContactPeak>>,
+    /// Where the fit's model is known to miss the log without that being a
+    /// reason (a one-sided wall's exits, [`exits_only_misfit`]), what and what
+    /// was done about it: the report and summary.json say so.
+    pub model_note: Option<String>,
 }
 
 pub use local::ReadingMethod;
@@ -467,6 +471,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         },
         acquisition_note: None,
         contact_readings: None,
+        model_note: None,
     }
 }
 
@@ -532,15 +537,26 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
 /// ([`uncertainty::add_model_spread_independent`]), since a model known to
 /// miss the log cannot be trusted to make the same error at every peak.
 /// Residuals that stand out around an entry (k even) keep their reason.
-fn exits_only_misfit(fit: &SegmentFit, response: &acquisition::ResponseUsed, phys: &Physics, dt: f64, sigma: f64) -> bool {
+/// Returns the note the report gives where it applies.
+fn exits_only_misfit(fit: &SegmentFit, response: &acquisition::ResponseUsed, phys: &Physics, dt: f64, sigma: f64) -> Option<String> {
     let m = fit.model();
     if phys.rocking != Rocking::OneSided || !fit.contacts || fit.estimated.is_some() || response.filter.is_some() || response.fir_cutoff_hz.is_some()
     {
-        return false;
+        return None;
     }
     let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
     let standing_out = checks::structured_impacts(&fit.tw, &fit.residuals(), &onsets, dt, sigma);
-    !standing_out.is_empty() && standing_out.iter().all(|(k, _)| k % 2 == 1)
+    if standing_out.is_empty() || standing_out.iter().any(|(k, _)| k % 2 == 0) {
+        return None;
+    }
+    let each: Vec<String> = standing_out
+        .iter()
+        .map(|(k, r)| format!("impact {k}, {:.1} × the noise", r / sigma))
+        .collect();
+    Some(format!(
+        "the residuals stand out where the wall leaves the transverse walls ({}): the model's contact there is not the wall's, the peaks are not read from there, and the fit's model-form terms are carried uncorrelated (wider u on the ratios; docs/estimator.md)",
+        each.join("; ")
+    ))
 }
 
 fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
@@ -568,7 +584,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Each peak's two readings of where its half-cycle ends (zero without
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
-    let exits_misfit = exits_only_misfit(&fit, &response, phys, p.dt, p.sigma);
+    let model_note = exits_only_misfit(&fit, &response, phys, p.dt, p.sigma);
+    let exits_misfit = model_note.is_some();
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
     let cov = peak_cov.map(|pc| {
@@ -663,5 +680,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         response,
         acquisition_note: fit.filter_dropped.clone(),
         contact_readings: None,
+        model_note,
     })
 }

@@ -304,6 +304,9 @@ fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
                         None => format!("data logger's filter: {}", r.analysis.response.describe()),
                     },
                 ]);
+                if let Some(note) = &r.analysis.model_note {
+                    notes.push(vec![t.spec.id.clone(), format!("fit: {note}")]);
+                }
                 let inward = r.analysis.contact_model_peaks();
                 if !inward.is_empty() {
                     let ks: Vec<String> = inward.iter().map(|k| k.to_string()).collect();

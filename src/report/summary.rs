@@ -56,6 +56,10 @@ struct Reduction<'a> {
     /// ([`crate::peaks::inward`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     peaks_read_by_contact_model: Vec<usize>,
+    /// Where the fit's model misses the log without that being a reason (a
+    /// one-sided wall's exits), what and what was done about it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    model_note: Option<&'a str>,
 }
 
 /// One entry of a test's `"impacts"`: the analysis' impact (time, side entered,
@@ -183,6 +187,7 @@ fn test_doc(t: &TestOutcome) -> TestDoc<'_> {
                 acquisition: &r.analysis.response,
                 acquisition_note: r.analysis.acquisition_note.as_deref(),
                 peaks_read_by_contact_model: r.analysis.contact_model_peaks(),
+                model_note: r.analysis.model_note.as_deref(),
             };
             (if reason.is_some() { "suspect" } else { "ok" }, reason, None, Some(reduction))
         }

@@ -15,6 +15,13 @@ const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", 
 
 /// A fixture campaign; with `unstated`, its manifest without the lines that
 /// state the logger's filter (the lab that does not know it: issue #18).
+/// The shipped fixture `name` reduced as its manifest says, and its truth.json.
+fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    (reduce_campaign(load_campaign(name, false), PeakOptions::default()), truth)
+}
+
 fn load_campaign(name: &str, unstated: bool) -> Campaign {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures/campaigns")
@@ -844,9 +851,7 @@ fn mujoco_holdouts_reduced_or_flagged() {
 #[test]
 fn a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios() {
     let name = "mujoco-holdout-one-sided";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-    let res = reduce_campaign(load_campaign(name, false), PeakOptions::default());
+    let (res, truth) = reduced_with_truth(name);
     for t in &res.tests {
         let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
         assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
@@ -922,9 +927,7 @@ fn engine_campaigns() {
 #[test]
 fn an_undetermined_fit_states_no_zero_uncertainty() {
     let name = "penalty-one-sided-singular";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-    let res = reduce_campaign(load_campaign(name, false), PeakOptions::default());
+    let (res, truth) = reduced_with_truth(name);
     let t = &res.tests[0];
     let a = &t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id)).analysis;
     let true_v: Vec<f64> = truth["tests"][0]["peaks"]

@@ -860,15 +860,38 @@ fn a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios() {
             let note = r.analysis.model_note.as_deref().unwrap_or_default();
             assert!(note.contains("impact 5") && note.contains("uncorrelated"), "{note}");
         }
-        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
-        let (c, u) = (
-            serde_json::to_value(r.coefficients).unwrap(),
-            serde_json::to_value(r.uncertainty.expect("u")).unwrap(),
-        );
-        for key in ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"] {
-            let err = (c[key].as_f64().unwrap() - tt[key].as_f64().unwrap()).abs();
-            let u = u[key].as_f64().unwrap();
-            assert!(err <= 2.0 * u, "{} {key}: {:.2} pp off at u {:.2} pp", t.spec.id, 100.0 * err, 100.0 * u);
+        assert_values_cover_their_errors(r, &truth, &t.spec.id);
+    }
+}
+
+/// Every table value of `r` within 2 u of the truth's (test `id` of `truth`).
+fn assert_values_cover_their_errors(r: &rocklab::reduce::Reduced, truth: &serde_json::Value, id: &str) {
+    let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == id).unwrap();
+    let (c, u) = (
+        serde_json::to_value(r.coefficients).unwrap(),
+        serde_json::to_value(r.uncertainty.expect("u")).unwrap(),
+    );
+    for key in ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"] {
+        let err = (c[key].as_f64().unwrap() - tt[key].as_f64().unwrap()).abs();
+        let u = u[key].as_f64().unwrap();
+        assert!(err <= 2.0 * u, "{id} {key}: {:.2} pp off at u {:.2} pp", 100.0 * err, 100.0 * u);
+    }
+}
+
+/// The model-form spread between the two models of the contacts, partly
+/// shared by a test's peaks (`uncertainty::add_model_spread_partly`,
+/// twentieth session). Fully shared, it cancelled in the ratios more than the
+/// errors did: the public two-sided P2_100_1 was ok with r⁻ 0.39 pp off at
+/// u 0.17 pp (2.3 u). Now every ok value of the public two-sided campaign
+/// covers its error within 2 u (measured: P2_100_1 r⁻ at u 0.27, 1.4 u); the
+/// test fails with the term fully shared.
+#[test]
+fn a_partly_shared_model_spread_covers_the_ratios_errors() {
+    let (res, truth) = reduced_with_truth("mujoco-public-two-sided");
+    for t in &res.tests {
+        let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
+        if r.analysis.quality.is_ok() {
+            assert_values_cover_their_errors(r, &truth, &t.spec.id);
         }
     }
 }

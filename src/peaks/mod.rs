@@ -534,7 +534,7 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
 /// 0.3 of its u (nine tests, twentieth session): the peaks are not read from
 /// there. Such a fit is not suspect for those residuals; its model-form terms
 /// are carried uncorrelated instead
-/// ([`uncertainty::add_model_spread_independent`]), since a model known to
+/// ([`uncertainty::add_model_spread_partly`] with s² = 1/3), since a model known to
 /// miss the log cannot be trusted to make the same error at every peak.
 /// Residuals that stand out around an entry (k even) keep their reason.
 /// Returns the note the report gives where it applies.
@@ -597,18 +597,21 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         if !fit.contacts {
             uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
         }
-        // Where the model misses the log at exits, its model-form terms are
-        // not taken to cancel in the ratios (`exits_only_misfit`).
-        let model_spread = if exits_misfit {
-            uncertainty::add_model_spread_independent
+        // The two models of the contacts: their spread is partly shared by
+        // the peaks, and not at all where the model misses the log at exits
+        // (`exits_only_misfit`).
+        let s = if exits_misfit {
+            1.0 / 3f64.sqrt()
+        } else if phys.rocking == Rocking::OneSided {
+            uncertainty::PEAK_TO_PEAK_ONE_SIDED
         } else {
-            uncertainty::add_model_spread
+            uncertainty::PEAK_TO_PEAK_TWO_SIDED
         };
         if let Some(alt) = &fit.alternative {
-            model_spread(&mut c, &impacts, alt);
+            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
         }
         if let Some(alt) = &fit.rival_minimum {
-            model_spread(&mut c, &impacts, alt);
+            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
         if let Some((est, cutoff)) = &fit.estimated {

@@ -42,9 +42,9 @@ pub(super) fn add_model_spread(cov: &mut [Vec<f64>], impacts: &[Impact], alterna
 /// How far the truth's place between the two models of the contacts (the
 /// fraction f_k of the way from the chosen peak to the other, d_k) varies
 /// from peak to peak of one test: its standard deviation s, measured on the
-/// MuJoCo engine campaigns (docs/accuracy.md, "The model-form term, partly
-/// shared"): median 0.32 over 104 one-sided tests with contact phases, 0.14
-/// over 58 two-sided ones.
+/// engine campaigns, MuJoCo's and the penalty engine's (docs/accuracy.md, "The
+/// model-form term, partly shared"): median 0.32 over 104 one-sided tests with
+/// contact phases, 0.14 over 58 two-sided ones.
 pub(super) const PEAK_TO_PEAK_ONE_SIDED: f64 = 0.32;
 /// See [`PEAK_TO_PEAK_ONE_SIDED`].
 pub(super) const PEAK_TO_PEAK_TWO_SIDED: f64 = 0.14;

@@ -871,7 +871,7 @@ fn assert_values_cover_their_errors(r: &rocklab::reduce::Reduced, truth: &serde_
         serde_json::to_value(r.coefficients).unwrap(),
         serde_json::to_value(r.uncertainty.expect("u")).unwrap(),
     );
-    for key in ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"] {
+    for key in KEYS {
         let err = (c[key].as_f64().unwrap() - tt[key].as_f64().unwrap()).abs();
         let u = u[key].as_f64().unwrap();
         assert!(err <= 2.0 * u, "{id} {key}: {:.2} pp off at u {:.2} pp", 100.0 * err, 100.0 * u);

@@ -500,10 +500,8 @@ fn late_readings(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, n_pe
 /// the unstated FIR draw trips it). The case the FIR branch was measured on:
 /// docs/accuracy.md, "A campaign logged at 100 Hz".
 fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, peaks: &[Peak], n_peaks: usize) -> Option<String> {
-    let m = fit.model();
     let estimated_fir = fit.estimated.as_ref().is_some_and(|(e, _)| e.kind == acquisition::Generic::Fir64);
-    let unfiltered_contacts = fit.contacts && m.filter.is_none() && fit.estimated.is_none();
-    if phys.rocking != Rocking::OneSided || !(unfiltered_contacts || estimated_fir) {
+    if phys.rocking != Rocking::OneSided || !(unfiltered_contacts(fit) || estimated_fir) {
         return None;
     }
     let read = late_readings(t, p, phys, fit, n_peaks);
@@ -518,9 +516,12 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
     checks::kink_disagreement(&v, &u, &kink)
 }
 
-/// The default estimator: the global fit ([`segments`]), its covariance with the
-/// model-form terms ([`uncertainty`]), the second estimate of each peak and the
-/// checks ([`quality`]).
+/// A fit with contact phases and no logger filter in its model, stated or
+/// estimated.
+fn unfiltered_contacts(fit: &SegmentFit) -> bool {
+    fit.contacts && fit.model().filter.is_none() && fit.estimated.is_none()
+}
+
 /// A one-sided fit with contact phases, seen through no logger filter, whose
 /// residuals stand out around exit impacts only (k odd: the crossings where
 /// the wall leaves the transverse walls, [`checks::structured_impacts`]).
@@ -538,14 +539,13 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
 /// miss the log cannot be trusted to make the same error at every peak.
 /// Residuals that stand out around an entry (k even) keep their reason.
 /// Returns the note the report gives where it applies.
-fn exits_only_misfit(fit: &SegmentFit, response: &acquisition::ResponseUsed, phys: &Physics, dt: f64, sigma: f64) -> Option<String> {
+fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, sigma: f64) -> Option<String> {
     let m = fit.model();
-    if phys.rocking != Rocking::OneSided || !fit.contacts || fit.estimated.is_some() || response.filter.is_some() || response.fir_cutoff_hz.is_some()
-    {
+    if phys.rocking != Rocking::OneSided || !unfiltered_contacts(fit) {
         return None;
     }
     let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
-    let standing_out = checks::structured_impacts(&fit.tw, &fit.residuals(), &onsets, dt, sigma);
+    let standing_out = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
     if standing_out.is_empty() || standing_out.iter().any(|(k, _)| k % 2 == 0) {
         return None;
     }
@@ -559,6 +559,9 @@ fn exits_only_misfit(fit: &SegmentFit, response: &acquisition::ResponseUsed, phy
     ))
 }
 
+/// The default estimator: the global fit ([`segments`]), its covariance with the
+/// model-form terms ([`uncertainty`]), the second estimate of each peak and the
+/// checks ([`quality`]).
 fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
     let n_peaks = opts.n_peaks;
     let (filter, mut response) = acquisition::stated(&opts.acquisition);
@@ -584,7 +587,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Each peak's two readings of where its half-cycle ends (zero without
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
-    let model_note = exits_only_misfit(&fit, &response, phys, p.dt, p.sigma);
+    let resid = fit.residuals();
+    let model_note = exits_only_misfit(&fit, &resid, phys, p.dt, p.sigma);
     let exits_misfit = model_note.is_some();
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
@@ -648,7 +652,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         }
         late_readings(t, &p, phys, &fit, n_peaks)
     };
-    let verdict = quality::plausibility(&fit, &peaks, &local, &spread, &methods, (p.dt, p.sigma), exits_misfit, &late);
+    let verdict = quality::plausibility(&fit, &resid, &peaks, &local, &spread, &methods, (p.dt, p.sigma), exits_misfit, &late);
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):

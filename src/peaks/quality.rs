@@ -37,6 +37,8 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 /// of that contact (its length, its overshoot, its zero readings, the residuals
 /// around it, the re-fit of the arc's end) are not run for it.
 ///
+/// `resid`: the fit's residuals over its window ([`SegmentFit::residuals`]).
+///
 /// Residuals that stand out around an impact are a reason only where the
 /// local readings of the peaks (`late`, computed only then) do not vouch for
 /// the global fit's ([`vouch`]), and not where they stand out around a
@@ -44,6 +46,7 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 #[allow(clippy::too_many_arguments)]
 pub(super) fn plausibility(
     fit: &SegmentFit,
+    resid: &[f64],
     peaks: &[Peak],
     local: &[Option<(f64, f64)>],
     spread: &[f64],
@@ -65,7 +68,6 @@ pub(super) fn plausibility(
     let v_onset: Vec<f64> = (0..v.len()).map(|k| m.speeds(k).0).collect();
     let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
     let onsets: Vec<f64> = (0..m.m()).map(|k| if is_local(k) { f64::NAN } else { m.onset(k) }).collect();
-    let resid = fit.residuals();
     // Impacts 0..n−1: the ones that end the peaks the tables use, the last
     // one's included (it ends peak n−1: an exit that gains speed there has
     // that peak's time wrong, docs/estimator.md).
@@ -75,11 +77,11 @@ pub(super) fn plausibility(
         checks::alternation(&v),
         checks::energy_gain(&v, &u),
         checks::impact_gains_speed(&v, &after, &u),
-        checks::misfit(&resid, sigma),
+        checks::misfit(resid, sigma),
         if exits_misfit {
             None
         } else {
-            structured_unvouched(fit, &resid, &onsets, peaks, dt, sigma, late)
+            structured_unvouched(fit, resid, &onsets, peaks, dt, sigma, late)
         },
         checks::disagreement(&v_onset, &u, &local),
         m.contact_windows().and_then(|windows| {

@@ -559,6 +559,17 @@ fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, s
     ))
 }
 
+/// What the report says of an estimated low-pass that rounds the impacts as
+/// widely as the wall's contacts do ([`acquisition::WIDE_ROUNDING`]).
+fn wide_rounding_note(est: &acquisition::Estimate, dt: f64) -> Option<String> {
+    est.contact_rival.as_ref().filter(|_| est.wide_rounding).map(|_| {
+        format!(
+            "estimated at {:.3} of the sampling rate, below a logger's usual anti-alias setting: a compliant contact rounds the impacts as widely, and the contact-phase reading is carried as one standard uncertainty (wider u); state the filter (\"none\" if the logger has none) to narrow it",
+            est.cutoff_hz * dt
+        )
+    })
+}
+
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
@@ -623,8 +634,10 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             if let Some((_, other)) = &est.runner_up {
                 uncertainty::add_model_spread(&mut c, &impacts, other);
             }
-            if let Some((other, _)) = &est.contact_rival {
-                uncertainty::add_model_spread(&mut c, &impacts, other);
+            match &est.contact_rival {
+                Some((other, _)) if est.wide_rounding => uncertainty::add_model_alternative(&mut c, &impacts, other),
+                Some((other, _)) => uncertainty::add_model_spread(&mut c, &impacts, other),
+                None => {}
             }
         }
         c
@@ -685,7 +698,10 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         local_peaks: local,
         methods,
         response,
-        acquisition_note: fit.filter_dropped.clone(),
+        acquisition_note: fit
+            .filter_dropped
+            .clone()
+            .or_else(|| fit.estimated.as_ref().and_then(|(e, _)| wide_rounding_note(e, p.dt))),
         contact_readings: None,
         model_note,
     })

@@ -39,6 +39,16 @@ pub(super) fn add_model_spread(cov: &mut [Vec<f64>], impacts: &[Impact], alterna
     add_correlated(cov, &spread_of(cov.len(), impacts, alternative), 1.0 / 3.0);
 }
 
+/// A rival model's reading as one standard uncertainty of every peak, fully
+/// correlated: Σ += d dᵀ, d_k the rival's peak minus the chosen one. For a
+/// rival the log cannot rule out and the truth was found at or beyond
+/// (`acquisition::WIDE_ROUNDING`: 1.0–1.5 d from the chosen reading), where
+/// the rectangle between the two ([`add_model_spread`], d dᵀ/3) understated
+/// the error.
+pub(super) fn add_model_alternative(cov: &mut [Vec<f64>], impacts: &[Impact], alternative: &[f64]) {
+    add_correlated(cov, &spread_of(cov.len(), impacts, alternative), 1.0);
+}
+
 /// How far the truth's place between the two models of the contacts (the
 /// fraction f_k of the way from the chosen peak to the other, d_k) varies
 /// from peak to peak of one test: its standard deviation s, measured on the

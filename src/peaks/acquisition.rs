@@ -799,7 +799,7 @@ pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Re
 /// the contacts' reading was the right one (campaign mode reads these tests
 /// with contact phases, 0.35–0.9 pp off) and the filter's r was 0.78–1.52 pp
 /// high, 2.2–4.1 of its u. The truth lay at or beyond the contacts' reading
-/// (1.0–1.5 of the difference d between the readings), so d is carried as
+/// (about 1.0–1.5 of the difference d between the readings), so d is carried as
 /// one standard uncertainty, Σ += d dᵀ, not as the ends of a rectangle.
 pub const WIDE_ROUNDING: f64 = 0.25;
 

@@ -256,8 +256,10 @@ pub struct Analysis {
     /// table takes them from here instead of reading them again.
     pub contact_readings: Option<Vec<late::ContactPeak>>,
     /// Where the fit's model is known to miss the log without that being a
-    /// reason (a one-sided wall's exits, [`exits_only_misfit`]), what and what
-    /// was done about it: the report and summary.json say so.
+    /// reason (a one-sided wall's exits, [`exits_only_misfit`]), or the log
+    /// leans towards contact phases that were not chosen
+    /// (`segments::leaning_contacts`), what and what was done about it: the
+    /// report and summary.json say so.
     pub model_note: Option<String>,
 }
 
@@ -570,6 +572,10 @@ fn wide_rounding_note(est: &acquisition::Estimate, dt: f64) -> Option<String> {
     })
 }
 
+/// What the report says of a one-sided log whose contact-phase fit the data
+/// lean towards without asking for it (`segments::leaning_contacts`).
+const LEANING_NOTE: &str = "contact phases fit this log better than instantaneous impacts by more than their extra parameters explain (the Akaike criterion), but not clearly enough to be chosen (the Bayesian criterion): the peaks are read with instantaneous impacts, and the contact-phase reading is carried in u as the other model of the contacts";
+
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the
 /// checks ([`quality`]).
@@ -626,6 +632,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
         }
         if let Some(alt) = &fit.rival_minimum {
+            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
+        }
+        if let Some(alt) = &fit.leaning {
             uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
         }
         uncertainty::add_zero_spread(&mut c, &spread);
@@ -703,6 +712,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             .clone()
             .or_else(|| fit.estimated.as_ref().and_then(|(e, _)| wide_rounding_note(e, p.dt))),
         contact_readings: None,
-        model_note,
+        model_note: model_note.or_else(|| fit.leaning.as_ref().map(|_| LEANING_NOTE.to_string())),
     })
 }

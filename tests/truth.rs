@@ -22,6 +22,17 @@ fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_jso
     (reduce_campaign(load_campaign(name, false), PeakOptions::default()), truth)
 }
 
+/// Test `id` of the fixture campaign `name` reduced alone (a campaign of that
+/// one test: no other test to say what its wall's contacts are), with the
+/// campaign's truth.
+fn reduced_alone(name: &str, id: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
+    alone.tests.retain(|t| t.id == id);
+    (reduce_campaign(alone, PeakOptions::default()), truth)
+}
+
 fn load_campaign(name: &str, unstated: bool) -> Campaign {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures/campaigns")
@@ -235,12 +246,8 @@ fn the_pushes_peaks_are_read_by_the_contact_model() {
 fn an_exit_that_gains_speed_at_the_last_table_peak_is_flagged() {
     use rocklab::report::quality::{kind, split, Kind};
     let name = "mujoco-100hz-one-sided-in-campaign";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let (res, truth) = reduced_alone(name, "Q1_155_1");
     let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == "Q1_155_1").unwrap();
-    let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    alone.tests.retain(|t| t.id == "Q1_155_1");
-    let res = reduce_campaign(alone, PeakOptions::default());
     let r = res.tests[0].result.as_ref().unwrap();
     let why = r.suspect_reason().expect("read alone, Q1_155_1 is suspect");
     assert!(
@@ -893,11 +900,7 @@ fn a_wide_estimated_rounding_carries_the_contacts_reading() {
         ("mujoco-holdout-two-sided", "H2_80_1"),
         ("mujoco-public-like-two-sided-100hz", "Q2_110_1"),
     ] {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-        let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-        let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
-        alone.tests.retain(|t| t.id == id);
-        let res = reduce_campaign(alone, PeakOptions::default());
+        let (res, truth) = reduced_alone(name, id);
         let r = res.tests[0].result.as_ref().unwrap_or_else(|e| panic!("{id}: {e}"));
         assert!(r.analysis.quality.is_ok(), "{id}: {}", r.analysis.quality.describe());
         assert_eq!(r.analysis.response.source, "estimated", "{id}");
@@ -919,12 +922,7 @@ fn a_wide_estimated_rounding_carries_the_contacts_reading() {
 /// u (`segments::leaning_contacts`) and the note says so. Measured: 1.9 u.
 #[test]
 fn contacts_a_one_sided_log_leans_towards_are_carried_in_u() {
-    let name = "mujoco-public-one-sided";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-    let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    alone.tests.retain(|t| t.id == "P1_150_1");
-    let res = reduce_campaign(alone, PeakOptions::default());
+    let (res, truth) = reduced_alone("mujoco-public-one-sided", "P1_150_1");
     let r = res.tests[0].result.as_ref().unwrap_or_else(|e| panic!("P1_150_1: {e}"));
     assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
     assert!(!r.analysis.contact_phases, "read with instantaneous impacts");

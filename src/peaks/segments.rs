@@ -277,8 +277,9 @@ impl SegmentFit {
 /// beside the half-cycles they join ([`super::checks::contact_too_long`], the
 /// check a chosen one must pass) is a credible reading: on daq-public-bessel-1
 /// T1_3 with its filter not stated, a contact fit with a contact longer than
-/// that gained 21.6 σ² and read peak 5 at 26 mm/s against 95, and carried in
-/// u it left the test suspect for a u of ± 8 pp on r (it is 0.47 pp off).
+/// that gained 21.6 σ² and read peak 5 at 26 mm/s (the instantaneous fit: 95),
+/// and carried in u it left the test suspect for a u of ± 8 pp on r (it is
+/// 0.47 pp off).
 fn leaning_contacts(simple: &Fitted, c: &Fitted, extra: f64, sigma2: f64) -> Option<Vec<f64>> {
     let gain = (simple.fit.cost - c.fit.cost) / sigma2;
     let m = &c.model;

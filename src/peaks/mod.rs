@@ -566,7 +566,7 @@ fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, s
 fn wide_rounding_note(est: &acquisition::Estimate, dt: f64) -> Option<String> {
     est.contact_rival.as_ref().filter(|_| est.wide_rounding).map(|_| {
         format!(
-            "estimated at {:.3} of the sampling rate, below a logger's usual anti-alias setting: a compliant contact rounds the impacts as widely, and the contact-phase reading is carried as one standard uncertainty (wider u); state the filter (\"none\" if the logger has none) to narrow it",
+            "its cut-off is {:.3} of the sampling rate, below a logger's usual anti-alias setting: a compliant contact rounds the impacts as widely, and the contact-phase reading is carried as one standard uncertainty (wider u); state the filter (\"none\" if the logger has none) to narrow it",
             est.cutoff_hz * dt
         )
     })

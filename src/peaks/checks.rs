@@ -189,6 +189,20 @@ pub fn contact_too_long(windows: &[(f64, f64)], arcs: &[f64], spring: &[bool]) -
     })
 }
 
+/// [`contact_too_long`] for the contact windows `windows` of model
+/// `m`: its arcs' lengths, and which of them are inward arcs against the
+/// transverse walls (one-sided, s odd). Also the credibility of a rival
+/// contact fit (`segments::leaning_contacts`).
+pub fn contacts_too_long(m: &super::model::Model, windows: &[(f64, f64)]) -> Option<String> {
+    let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
+    contact_too_long(windows, &arcs, &inward_arcs(m))
+}
+
+/// Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
+pub fn inward_arcs(m: &super::model::Model) -> Vec<bool> {
+    (0..m.m()).map(|s| m.one_sided && s % 2 == 1).collect()
+}
+
 /// Inside a contact phase the velocity may still rise a little before it falls,
 /// but a peak more than 5 % (+ 3 u) above the free arc's speed at the onset is
 /// the interpolant's overshoot, not the wall.

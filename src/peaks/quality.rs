@@ -61,8 +61,7 @@ pub(super) fn plausibility(
     let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
     let u: Vec<f64> = peaks.iter().map(|p| p.velocity_u_mm_s.unwrap_or(0.0)).collect();
     let m = fit.model();
-    // Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
-    let spring: Vec<bool> = (0..m.m()).map(|s| m.one_sided && s % 2 == 1).collect();
+    let spring = checks::inward_arcs(m);
     let overshoot_skip: Vec<bool> = (0..m.m()).map(|s| spring[s] || is_local(s)).collect();
     // The local re-fit estimates the free arc's slope at the onset of contact.
     let v_onset: Vec<f64> = (0..v.len()).map(|k| m.speeds(k).0).collect();
@@ -90,8 +89,7 @@ pub(super) fn plausibility(
                 .enumerate()
                 .map(|(k, &w)| if is_local(k) { (0.0, 0.0) } else { w })
                 .collect();
-            let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
-            checks::contact_too_long(&windows, &arcs, &spring)
+            checks::contacts_too_long(m, &windows)
         }),
         if fit.contacts {
             checks::contact_overshoot(&v, &v_onset, &u, &overshoot_skip)

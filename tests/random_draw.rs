@@ -336,3 +336,37 @@ fn tests_once_ok_but_off_are_reduced_or_flagged() {
         "seed 1181: {note:?}"
     );
 }
+
+/// A two-sided compliant test fitted to the noise by instantaneous impacts
+/// carries its contact-phase reading in u (`segments::leaning_contacts`,
+/// twenty-second session): the compliant draw's seeds 138 and 373 read their
+/// peaks up to 23.0 and 13.8 of their u off before (their ratios were right);
+/// measured since: 1.89 and 1.25 u. Each peak within 2 u of the draw's truth,
+/// the reading still the instantaneous one, and the note says why u is wider.
+#[test]
+fn contacts_a_two_sided_log_leans_towards_are_carried_in_u() {
+    use rocklab::peaks::{analyse, PeakOptions, Physics};
+    for seed in [138, 373] {
+        let s = draw(seed, Family::Compliant);
+        assert!(!s.spec.one_sided(), "seed {seed} is a two-sided draw");
+        let phys = Physics {
+            rocking: rocklab::wall::Rocking::TwoSided,
+            lever_arm_mm: s.spec.lever_mm,
+            p_guess: s.spec.p2().sqrt(),
+        };
+        let a = analyse(&s.t, &s.x_mm, &phys, &PeakOptions::default()).expect("analysed");
+        assert!(a.quality.is_ok(), "seed {seed}: {}", a.quality.describe());
+        assert!(!a.contact_phases, "seed {seed}: read with instantaneous impacts");
+        let note = a.model_note.as_deref().unwrap_or_default();
+        assert!(note.contains("12 σ²") && note.contains("carried in u"), "seed {seed}: {note}");
+        for (k, (p, t)) in a.peaks.iter().zip(&s.peaks).take(6).enumerate() {
+            let u = p.velocity_u_mm_s.expect("a stated u");
+            let z = (p.velocity_mm_s - t.1).abs() / u;
+            assert!(
+                z <= 2.0,
+                "seed {seed} peak {k}: {:.2} mm/s off at u {u:.2} ({z:.2} u)",
+                p.velocity_mm_s - t.1
+            );
+        }
+    }
+}

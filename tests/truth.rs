@@ -927,7 +927,7 @@ fn contacts_a_one_sided_log_leans_towards_are_carried_in_u() {
     assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
     assert!(!r.analysis.contact_phases, "read with instantaneous impacts");
     let note = r.analysis.model_note.as_deref().unwrap_or_default();
-    assert!(note.contains("Akaike") && note.contains("carried in u"), "{note}");
+    assert!(note.contains("12 σ²") && note.contains("carried in u"), "{note}");
     assert_values_cover_their_errors(r, &truth, "P1_150_1");
 }
 

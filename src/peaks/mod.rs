@@ -572,9 +572,9 @@ fn wide_rounding_note(est: &acquisition::Estimate, dt: f64) -> Option<String> {
     })
 }
 
-/// What the report says of a one-sided log whose contact-phase fit the data
+/// What the report says of a log whose contact-phase fit the data
 /// lean towards without asking for it (`segments::leaning_contacts`).
-const LEANING_NOTE: &str = "contact phases fit this log better than instantaneous impacts by more than their extra parameters explain (the Akaike criterion), but not clearly enough to be chosen (the Bayesian criterion): the peaks are read with instantaneous impacts, and the contact-phase reading is carried in u as the other model of the contacts";
+const LEANING_NOTE: &str = "contact phases fit this log better than instantaneous impacts by more than their extra parameters explain (by over 12 σ²), but not clearly enough to be chosen (the Bayesian criterion): the peaks are read with instantaneous impacts, and the contact-phase reading is carried in u as the other model of the contacts";
 
 /// The default estimator: the global fit ([`segments`]), its covariance with the
 /// model-form terms ([`uncertainty`]), the second estimate of each peak and the

@@ -550,7 +550,8 @@ pub struct Scored {
     /// Worst |error| over the seven table values (percentage points), or the
     /// estimator's error message.
     pub worst_pp: Result<f64, ScoreError>,
-    /// The quality the estimator claimed ("ok", "suspect: …").
+    /// The quality `reduce` would claim ("ok", "suspect: …"): the estimator's,
+    /// and a ratio read to more than ± 5 pp is not vouched for.
     pub status: String,
     /// Why an estimated logger filter was dropped for the contacts' rounding,
     /// if it was (`Analysis::acquisition_note`).
@@ -584,8 +585,14 @@ pub fn score_with(s: &Synthetic, opts: &crate::peaks::PeakOptions) -> Scored {
     let acquisition_note = res.as_ref().ok().and_then(|a| a.acquisition_note.clone());
     let (worst_pp, status) = match res {
         Err(e) => (Err(ScoreError::Peaks(e)), "error".to_string()),
-        Ok(a) => {
+        Ok(mut a) => {
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
+            // The status `reduce` gives: also a ratio read to more than ± 5 pp
+            // is not vouched for (`crate::reduction::reduce_log`).
+            let u = a.peak_covariance.as_ref().and_then(|cov| crate::restitution::uncertainties(&v, cov, e_h));
+            if let (Some(u), Some(cov)) = (&u, &a.peak_covariance) {
+                a.quality = a.quality.with(crate::restitution::unresolved_reason(u, &v, cov));
+            }
             match coefficients(&v, e_h) {
                 None => (Err(ScoreError::FewerThanSix(v.len())), "error".into()),
                 Some(c) => {

@@ -257,6 +257,15 @@ impl SegmentFit {
     }
 }
 
+/// The gain (σ²) above which a contact-phase fit the data did not ask for is
+/// carried in u ([`leaning_contacts`]): the Akaike criterion 2k of the
+/// one-sided contact model (k = 6). Two-sided (k = 3) its 2k = 6 σ² was
+/// measured too: on `synth`'s idealised draw (400 seeds, instantaneous
+/// impacts) it applied to 21 % of the two-sided tests, at 12 σ² to 8 %
+/// (one-sided 6.5 %), and on the compliant draw it took the two-sided peaks
+/// within 2 u to 96 % against 93 % at 12 σ².
+pub(crate) const LEANING_GAIN: f64 = 12.0;
+
 /// The peaks of the contact-phase fit `c` of a log that the
 /// instantaneous-impact fit `simple` describes to the noise, where the data
 /// lean towards the contacts without asking for them: a cost gain above
@@ -285,15 +294,6 @@ impl SegmentFit {
 /// that gained 21.6 σ² and read peak 5 at 26 mm/s (the instantaneous fit: 95),
 /// and carried in u it left the test suspect for a u of ± 8 pp on r (it is
 /// 0.47 pp off).
-/// The gain (σ²) above which a contact-phase fit the data did not ask for is
-/// carried in u ([`leaning_contacts`]): the Akaike criterion 2k of the
-/// one-sided contact model (k = 6). Two-sided (k = 3) its 2k = 6 σ² was
-/// measured too: on `synth`'s idealised draw (400 seeds, instantaneous
-/// impacts) it applied to 21 % of the two-sided tests, at 12 σ² to 8 %
-/// (one-sided 6.5 %), and on the compliant draw it took the two-sided peaks
-/// within 2 u to 96 % against 93 % at 12 σ².
-pub(crate) const LEANING_GAIN: f64 = 12.0;
-
 fn leaning_contacts(simple: &Fitted, c: &Fitted, sigma2: f64) -> Option<Vec<f64>> {
     let gain = (simple.fit.cost - c.fit.cost) / sigma2;
     let m = &c.model;

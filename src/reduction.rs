@@ -92,10 +92,7 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
     let mut analysis = analyse(&log.time_s, &log.disp_mm, phys, options)?;
     let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
     let c = coefficients(&v, e_housner).ok_or(ReduceError::TooFewPeaks { found: v.len() })?;
-    let u = analysis.peak_covariance.as_ref().and_then(|cov| uncertainties(&v, cov, e_housner));
-    if let (Some(u), Some(cov)) = (&u, &analysis.peak_covariance) {
-        analysis.quality = analysis.quality.with(unresolved_reason(u, &v, cov));
-    }
+    let u = vouch(&mut analysis, e_housner);
     Ok(Reduced {
         log,
         analysis,
@@ -105,6 +102,19 @@ pub fn reduce_log(log: LogData, phys: &Physics, e_housner: f64, options: &PeakOp
         impact_peaks: 0,
         law_end: None,
     })
+}
+
+/// The table values' uncertainties from the peaks' covariance, and the
+/// analysis's quality with what it cannot vouch for added: a ratio read to
+/// more than ± 5 pp ([`unresolved_reason`]). What `reduce` reports, and what
+/// the random draws score (`crate::synth::score_with`).
+pub fn vouch(analysis: &mut Analysis, e_housner: f64) -> Option<Coefficients> {
+    let v: Vec<f64> = analysis.peaks.iter().map(|p| p.velocity_mm_s).collect();
+    let cov = analysis.peak_covariance.as_ref()?;
+    let u = uncertainties(&v, cov, e_housner)?;
+    let why = unresolved_reason(&u, &v, cov);
+    analysis.quality = std::mem::replace(&mut analysis.quality, Quality::Ok).with(why);
+    Some(u)
 }
 
 /// The most peaks any log is read for its impacts (eleven impacts, as many as

@@ -586,13 +586,9 @@ pub fn score_with(s: &Synthetic, opts: &crate::peaks::PeakOptions) -> Scored {
     let (worst_pp, status) = match res {
         Err(e) => (Err(ScoreError::Peaks(e)), "error".to_string()),
         Ok(mut a) => {
+            // The status `reduce` gives.
+            crate::reduction::vouch(&mut a, e_h);
             let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
-            // The status `reduce` gives: also a ratio read to more than ± 5 pp
-            // is not vouched for (`crate::reduction::reduce_log`).
-            let u = a.peak_covariance.as_ref().and_then(|cov| crate::restitution::uncertainties(&v, cov, e_h));
-            if let (Some(u), Some(cov)) = (&u, &a.peak_covariance) {
-                a.quality = a.quality.with(crate::restitution::unresolved_reason(u, &v, cov));
-            }
             match coefficients(&v, e_h) {
                 None => (Err(ScoreError::FewerThanSix(v.len())), "error".into()),
                 Some(c) => {

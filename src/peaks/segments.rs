@@ -52,8 +52,8 @@ pub struct SegmentFit {
     /// Where an unstated filter was estimated and then dropped for the wall's
     /// contacts' signature, why ([`super::acquisition::rival`]).
     pub filter_dropped: Option<String>,
-    /// The peaks of a one-sided contact-phase fit that the data lean towards
-    /// without asking for it ([`leaning_contacts`]): a model-form spread.
+    /// The peaks of a contact-phase fit that the data lean towards without
+    /// asking for it ([`leaning_contacts`]): a model-form spread.
     pub leaning: Option<Vec<f64>>,
 }
 
@@ -131,9 +131,7 @@ impl SegmentFit {
                 continue;
             };
             if probe {
-                if probed.as_ref().is_none_or(|b| c.fit.cost < b.fit.cost) {
-                    probed = Some(c);
-                }
+                probed = Some(c);
                 continue;
             }
             // The data must ask for contact phases clearly: the Bayesian

@@ -135,8 +135,14 @@ use rocklab::synth::{draw_logged, score_with, LoggerDraw};
 /// Logged draws: each test through a random filter of `kind`, reduced with the
 /// filter stated in the options or not.
 fn run_logged(seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) -> Vec<Scored> {
+    run_logged_seeds(&seeds.collect::<Vec<_>>(), kind, stated)
+}
+
+/// [`run_logged`] over the draws `seeds`.
+fn run_logged_seeds(seeds: &[u64], kind: LoggerDraw, stated: bool) -> Vec<Scored> {
     seeds
-        .into_par_iter()
+        .par_iter()
+        .copied()
         .map(|s| {
             let (syn, logger) = draw_logged(s, Family::Rigid, kind);
             let acquisition = match (stated, logger.stated(syn.spec.fs_hz)) {
@@ -237,7 +243,8 @@ fn all_causal() -> LoggerDraw {
 }
 
 /// Both causal families (Bessel, Butterworth), order 2–8, over 0.10–0.45 f_s,
-/// stated: measured 99.0 % ok within 1 pp, none ok and more than 2 pp off.
+/// stated: measured 99.5 % ok within 1 pp (98.5 % before the fit started one
+/// group delay early), none ok and more than 2 pp off.
 #[test]
 #[ignore = "full logged draw: run in release (docs/acquisition.md)"]
 fn stated_causal_families_full_draw() {
@@ -277,6 +284,20 @@ fn fir_tests_once_missed_are_reduced() {
     let (rate, off) = summarise_logged("fir once missed", &scored);
     assert_eq!(off, 0);
     assert!(rate >= 0.99, "{rate}");
+}
+
+/// Stated-Bessel draws at 100 Hz that the fit merged two impacts of (flagged;
+/// 2404 also 24 pp off) while its start sat one group delay late: a stated
+/// filter's kinks come out of it that late, and so did the log's crossings the
+/// fit started from (`segments::starting_model`). Started that much earlier,
+/// each is ok and within 1 pp.
+#[test]
+fn stated_filter_tests_once_started_late_are_reduced() {
+    let scored = run_logged_seeds(&[2138, 2181, 2404], bessel(0.10, 0.40), true);
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status.starts_with("ok ") && w <= 1.0, "seed {}: {w:.2} pp [{}]", s.seed, s.status);
+    }
 }
 
 /// Compliant draws whose rounded contacts were taken for an unstated logger

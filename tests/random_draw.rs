@@ -254,7 +254,7 @@ fn stated_causal_families_full_draw() {
 }
 
 /// The same, not stated: measured 98.5 % ok within 1 pp, 3 flagged (0.04–0.39
-/// pp off; draw 6088, 0.81 pp off, is ok since its Butterworth 8 at 0.17 f_s
+/// pp off; 98.0 % while an equal fit of the contacts alone flagged a test; draw 6088, 0.81 pp off, is ok since its Butterworth 8 at 0.17 f_s
 /// carries the contacts' reading in u, docs/acquisition.md), none ok and more
 /// than 2 pp off (draw 6122, an 8th-order
 /// Butterworth once ok but 2.33 pp off, is in

@@ -179,7 +179,17 @@ mod tests {
             (checks::contact_overshoot(&[-100.0], &[-50.0], &[0.1], &[false]), Kind::ContactOvershoot),
             (checks::zero_readings_disagree(&[-100.0], &[40.0]), Kind::ZeroReadings),
             (
-                acquisition::contact_check(acquisition::Generic::Bessel4, 20.0, &[-100.0, 50.0], &[-100.0, 40.0], -1.0),
+                acquisition::contact_check_with_trend(
+                    acquisition::Generic::Bessel4,
+                    20.0,
+                    &[-100.0, 50.0],
+                    &[-100.0, 40.0],
+                    -1.0,
+                    &acquisition::Lean {
+                        trend: None,
+                        preferred: true,
+                    },
+                ),
                 Kind::FilterUnknown,
             ),
             (unresolved_case(), Kind::Unresolved),

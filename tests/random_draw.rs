@@ -300,6 +300,19 @@ fn stated_filter_tests_once_started_late_are_reduced() {
     }
 }
 
+/// Unstated-Bessel draws flagged while an equal fit of the contact phases
+/// alone made a test suspect (ratios 0.03 or more apart, no lean towards the
+/// contacts): each is ok and within 1 pp, the readings' difference in u
+/// (`acquisition::contact_check_with_trend`).
+#[test]
+fn unstated_tests_once_flagged_for_an_equal_contact_fit_are_reduced() {
+    let scored = run_logged_seeds(&[3060, 3069, 3118, 3198], bessel(0.25, 0.40), false);
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status.starts_with("ok ") && w <= 1.0, "seed {}: {w:.2} pp [{}]", s.seed, s.status);
+    }
+}
+
 /// Compliant draws whose rounded contacts were taken for an unstated logger
 /// filter (status ok, 1.8–5.8 pp off) before the contact-phase model became the
 /// filter's rival (`peaks::acquisition::rival`): none is ok and more than 2 pp

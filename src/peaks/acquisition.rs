@@ -462,7 +462,7 @@ fn fit_through(start: &Model, kind: Generic, fc: f64, dt: f64, tw: &[f64], yw: &
 /// τ₀ − τ. (A steep filter delays by more than two samples at 0.3 f_s: an
 /// 8th-order Butterworth by 2.5; without the move the fit started one or two
 /// samples off and settled in a ringing lobe: cost 3800× the noise.)
-fn delayed_start(start: &Model, filter: Arc<dyn Instrument>) -> Model {
+pub(super) fn delayed_start(start: &Model, filter: Arc<dyn Instrument>) -> Model {
     use super::model::ix;
     let mut m = start.clone();
     let shift = filter.delay() - start.filter.as_ref().map_or(0.0, |f| f.delay());

@@ -232,6 +232,11 @@ pub struct Analysis {
     pub quality: Quality,
     /// Covariance of the peak speeds (mm²/s²), default estimator only.
     pub peak_covariance: Option<Vec<Vec<f64>>>,
+    /// The global fit's own part of `peak_covariance`: s²(JᵀJ)⁻¹ with the
+    /// directions the log only bounds, before the model-form terms. Where
+    /// [`inward`] reads a peak on its own, this part is the global fit's and
+    /// is swapped for the local reading's.
+    pub fit_covariance: Option<Vec<Vec<f64>>>,
     /// Whether the fit chose finite-duration contacts (see [`model`]).
     pub contact_phases: bool,
     /// Fitted decay rate γ of the inward arcs (s⁻¹, one-sided).
@@ -461,6 +466,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         rms_mm: None,
         quality: Quality::Ok,
         peak_covariance: None,
+        fit_covariance: None,
         contact_phases: false,
         gamma_fit: None,
         small_arc: None,
@@ -609,12 +615,15 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     let exits_misfit = model_note.is_some();
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
-    let cov = peak_cov.map(|pc| {
+    let fit_cov = peak_cov.map(|pc| {
         let mut c = pc.cov;
         // Directions the log does not determine, each over its admissible range.
         for e in &pc.bounded {
             uncertainty::add_admissible_range(&mut c, e);
         }
+        c
+    });
+    let cov = fit_cov.clone().map(|mut c| {
         if !fit.contacts {
             uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
         }
@@ -700,6 +709,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         lambda_fit: fit.model().lambda(),
         rms_mm: Some(fit.rms),
         quality: verdict,
+        fit_covariance: cov.as_ref().and(fit_cov),
         peak_covariance: cov,
         contact_phases: fit.contacts,
         gamma_fit: fit.model().gamma(),

@@ -709,7 +709,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         lambda_fit: fit.model().lambda(),
         rms_mm: Some(fit.rms),
         quality: verdict,
-        fit_covariance: cov.as_ref().and(fit_cov),
+        // A peak read locally has its own row (`local::choose`): the global
+        // fit's part is no longer in it.
+        fit_covariance: cov.as_ref().and(fit_cov).filter(|_| !methods.contains(&ReadingMethod::LocalExtreme)),
         peak_covariance: cov,
         contact_phases: fit.contacts,
         gamma_fit: fit.model().gamma(),

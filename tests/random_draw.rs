@@ -300,7 +300,7 @@ fn stated_filter_tests_once_started_late_are_reduced() {
 /// Unstated-Bessel draws flagged while an equal fit of the contact phases
 /// alone made a test suspect (ratios 0.03 or more apart, no lean towards the
 /// contacts): each is ok and within 1 pp, the readings' difference in u
-/// (`acquisition::contact_check_with_trend`).
+/// (`acquisition::contact_check`).
 #[test]
 fn unstated_tests_once_flagged_for_an_equal_contact_fit_are_reduced() {
     each_ok_within_1pp(&run_logged_seeds(&[3060, 3069, 3118, 3198], bessel(0.25, 0.40), false));

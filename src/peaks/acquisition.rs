@@ -50,7 +50,7 @@
 //! rounding is the contacts' and the filter is dropped; where it falls by
 //! more than 2 u, or the contacts fit better by more than 2 σ² per extra
 //! parameter, the contact reading must agree with the filter's to 0.01 in
-//! the ratios of consecutive peaks ([`contact_check_with_trend`]).
+//! the ratios of consecutive peaks ([`contact_check`]).
 
 use std::sync::Arc;
 
@@ -423,7 +423,7 @@ pub struct Estimate {
     /// The contact-phase model fits the log better than the filter by more
     /// than 2 σ² per extra parameter (the Akaike criterion prefers it, where
     /// the Bayesian one, which chose the filter, does not): the data lean
-    /// towards the contacts ([`contact_check_with_trend`]).
+    /// towards the contacts ([`contact_check`]).
     pub contacts_preferred: bool,
     /// The rounding's trend from the earlier impacts to the later ones
     /// ([`rounding_trend`]), where it was measured.
@@ -723,7 +723,7 @@ pub struct Rivals<'a> {
 /// where it fits at least as well as the filter (cost ≤ the filter's), the
 /// data lean towards the contacts ([`Lean`]) and the ratios of consecutive
 /// peaks differ by more than 0.01, the test is suspect ([`family_check`],
-/// [`contact_check_with_trend`]): the log cannot say whether the wall's
+/// [`contact_check`]): the log cannot say whether the wall's
 /// contacts or the logger rounded its impacts. The filter kept is then tested
 /// against the contacts' signature ([`rounding_trend`], [`Trend::widens`]):
 /// where its rounding widens over the later impacts, the model chosen without
@@ -833,7 +833,7 @@ pub(super) fn add_cutoff_spread(cov: &mut [Vec<f64>], spread: &[Vec<f64>]) {
 /// response, the ratios of consecutive peaks (what the table values are made
 /// of) must agree between them to 0.01 (1 pp of e); so must the contact-phase
 /// model's where it fits the log at least as well and the data lean towards
-/// it ([`contact_check_with_trend`]): otherwise the log cannot say which
+/// it ([`contact_check`]): otherwise the log cannot say which
 /// response the logger had, or whether the rounding of its impacts is the
 /// logger's or the wall's, and the test is suspect with that reason.
 pub fn family_check(est: &Estimate, peaks: &[f64]) -> Option<String> {
@@ -852,7 +852,7 @@ pub fn family_check(est: &Estimate, peaks: &[f64]) -> Option<String> {
             trend: est.trend.filter(|t| t.leans()),
             preferred: est.contacts_preferred,
         };
-        why.extend(contact_check_with_trend(est.kind, est.cutoff_hz, peaks, other, *excess, &lean));
+        why.extend(contact_check(est.kind, est.cutoff_hz, peaks, other, *excess, &lean));
     }
     (!why.is_empty()).then(|| why.join("; "))
 }
@@ -883,7 +883,7 @@ pub struct Lean {
 /// (94.67 % ok within 1 pp; 96.83 % without that flag). Over 500 compliant draws it
 /// caught one test the lean rules did not (1329, 2.04 pp off; ok without the flag, every
 /// peak within 1.7 u, docs/acquisition.md).
-pub fn contact_check_with_trend(kind: Generic, cutoff_hz: f64, peaks: &[f64], other: &[f64], excess: f64, lean: &Lean) -> Option<String> {
+pub fn contact_check(kind: Generic, cutoff_hz: f64, peaks: &[f64], other: &[f64], excess: f64, lean: &Lean) -> Option<String> {
     let worst = ratio_difference(peaks, other);
     let leans = lean.trend.is_some() || lean.preferred;
     (leans && worst > 0.01 && excess <= 0.0).then(|| {
@@ -927,7 +927,7 @@ mod tests {
         assert!((ratio_difference(&filter, &other) - 0.04).abs() < 1e-9);
         let check = |peaks: &[f64], excess: f64, preferred: bool| {
             let lean = Lean { trend: None, preferred };
-            contact_check_with_trend(Generic::Bessel4, 33.4, &filter, peaks, excess, &lean)
+            contact_check(Generic::Bessel4, 33.4, &filter, peaks, excess, &lean)
         };
         assert!(check(&other, -4.3, false).is_none(), "an equal fit alone: the difference goes into u");
         let why = check(&other, -14.3, true).expect("flagged");
@@ -971,13 +971,13 @@ mod tests {
             gain: 2.8,
         };
         let lean = |trend: Option<Trend>, preferred: bool| Lean { trend, preferred };
-        assert!(contact_check_with_trend(Generic::Bessel4, 28.2, &filter, &near, -9.3, &lean(None, false)).is_none());
-        let why = contact_check_with_trend(Generic::Bessel4, 28.2, &filter, &near, -9.3, &lean(Some(trend), false)).expect("flagged");
+        assert!(contact_check(Generic::Bessel4, 28.2, &filter, &near, -9.3, &lean(None, false)).is_none());
+        let why = contact_check(Generic::Bessel4, 28.2, &filter, &near, -9.3, &lean(Some(trend), false)).expect("flagged");
         assert!(why.contains("22.7 Hz against 28.2 Hz") && why.contains("0.020"), "{why}");
-        let why = contact_check_with_trend(Generic::Bessel4, 28.2, &filter, &near, -27.6, &lean(None, true)).expect("flagged");
+        let why = contact_check(Generic::Bessel4, 28.2, &filter, &near, -27.6, &lean(None, true)).expect("flagged");
         assert!(why.contains("better, by more than their extra parameters"), "{why}");
         assert!(
-            contact_check_with_trend(Generic::Bessel4, 28.2, &filter, &near, 1.0, &lean(Some(trend), true)).is_none(),
+            contact_check(Generic::Bessel4, 28.2, &filter, &near, 1.0, &lean(Some(trend), true)).is_none(),
             "the filter fits better"
         );
     }

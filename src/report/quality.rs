@@ -179,7 +179,7 @@ mod tests {
             (checks::contact_overshoot(&[-100.0], &[-50.0], &[0.1], &[false]), Kind::ContactOvershoot),
             (checks::zero_readings_disagree(&[-100.0], &[40.0]), Kind::ZeroReadings),
             (
-                acquisition::contact_check_with_trend(
+                acquisition::contact_check(
                     acquisition::Generic::Bessel4,
                     20.0,
                     &[-100.0, 50.0],

@@ -251,6 +251,29 @@ fn a_push_the_global_fit_does_not_determine_is_read_by_the_contact_model() {
     assert_values_within(r, &truth, "Q1_140_1", 0.01);
 }
 
+/// A one-sided test whose residuals stand out where the wall leaves the
+/// transverse walls (impact 3, 11.3 σ) and at the entry right after it
+/// (impact 4, 8.1 σ): `mujoco-one-sided-entry-after-exit`, Q1_140_1 of the
+/// public-like stand-in seed 1416 (200 Hz). Until the twenty-fifth session
+/// an entry among them kept the reason and the test was suspect, its values
+/// within 0.81 pp of the truth. Re-fitted without the samples around both
+/// impacts its peaks move by at most 0.46 % (0.1 u): they are not read from
+/// there, the test is ok, its pushes are read by the contact model, and every
+/// value is within 0.3 pp (measured 0.26 pp) and 2 u.
+#[test]
+fn residuals_at_an_exit_and_the_entry_after_it_do_not_flag_a_test_whose_peaks_do_not_depend_on_them() {
+    let (res, truth) = reduced_with_truth("mujoco-one-sided-entry-after-exit");
+    let r = res.tests[0].result.as_ref().unwrap();
+    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
+    let note = r.analysis.model_note.as_deref().unwrap_or_default();
+    assert!(
+        note.contains("impact 3") && note.contains("impact 4") && note.contains("the entry after it"),
+        "{note}"
+    );
+    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
+    assert_values_within(r, &truth, "Q1_140_1", 0.003);
+}
+
 /// A one-sided wall logged at 100 Hz whose compliant contacts show in a sample
 /// or two (`mujoco-100hz-one-sided-in-campaign`: Q1_155_1 of the public-like
 /// stand-in, seed 1410, with two of its campaign's 200 Hz tests). Reduced

@@ -532,7 +532,8 @@ fn unfiltered_contacts(fit: &SegmentFit) -> bool {
 
 /// A one-sided fit with contact phases, seen through no logger filter, whose
 /// residuals stand out around exit impacts only (k odd: the crossings where
-/// the wall leaves the transverse walls, [`checks::structured_impacts`]).
+/// the wall leaves the transverse walls, [`checks::structured_impacts`]), or
+/// around exits and an entry right after one of them.
 ///
 /// There the engine's wall leaves the restraint across θ = 0 without a jump
 /// in speed, only its curvature changing sign (docs/accuracy.md, "One-sided:
@@ -545,26 +546,86 @@ fn unfiltered_contacts(fit: &SegmentFit) -> bool {
 /// are carried uncorrelated instead
 /// ([`uncertainty::add_model_spread_partly`] with s² = 1/3), since a model known to
 /// miss the log cannot be trusted to make the same error at every peak.
-/// Residuals that stand out around an entry (k even) keep their reason.
-/// Returns the note the report gives where it applies.
-fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, sigma: f64) -> Option<String> {
+///
+/// An entry (k even) whose residuals stand out keeps its reason, unless it
+/// follows an exit that stands out more (k − 1 in the list, with a larger
+/// spread: the free arc between them starts where the model's exit put it)
+/// and the peaks do not depend on the samples of either: re-fitted without
+/// the samples within ±[`LEAVE_OUT_SAMPLES`] of every impact that stands out,
+/// no peak moves by more than [`LEAVE_OUT_MOVE`] of its u ([`Misfit::vouch`],
+/// twenty-fifth session, docs/estimator.md).
+/// Returns the note the report gives where it applies, and whether the
+/// leave-out re-fit must vouch for it.
+fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, sigma: f64) -> Option<Misfit> {
     let m = fit.model();
     if phys.rocking != Rocking::OneSided || !unfiltered_contacts(fit) {
         return None;
     }
     let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
     let standing_out = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
-    if standing_out.is_empty() || standing_out.iter().any(|(k, _)| k % 2 == 0) {
+    let after_exit = |k: usize, r: f64| k > 0 && standing_out.iter().any(|&(j, rj)| j + 1 == k && rj > r);
+    let entries: Vec<usize> = standing_out.iter().filter(|(k, _)| k % 2 == 0).map(|&(k, _)| k).collect();
+    if standing_out.is_empty() || standing_out.iter().any(|&(k, r)| k % 2 == 0 && !after_exit(k, r)) {
         return None;
     }
     let each: Vec<String> = standing_out
         .iter()
         .map(|(k, r)| format!("impact {k}, {:.1} × the noise", r / sigma))
         .collect();
-    Some(format!(
-        "the residuals stand out where the wall leaves the transverse walls ({}): the model's contact there is not the wall's, the peaks are not read from there, and the fit's model-form terms are carried uncorrelated (wider u on the ratios; docs/estimator.md)",
-        each.join("; ")
-    ))
+    let vouch = (!entries.is_empty()).then(|| standing_out.iter().map(|&(k, _)| onsets[k]).collect());
+    let (where_, left_out) = if entries.is_empty() {
+        ("where the wall leaves the transverse walls", "")
+    } else {
+        (
+            "where the wall leaves the transverse walls and at the entry after it",
+            &*format!(", re-fitted without the samples around them no peak moves by more than {LEAVE_OUT_MOVE} of its u"),
+        )
+    };
+    Some(Misfit {
+        note: format!(
+            "the residuals stand out {where_} ({}): the model's contact there is not the wall's, the peaks are not read from there{left_out}, and the fit's model-form terms are carried uncorrelated (wider u on the ratios; docs/estimator.md)",
+            each.join("; ")
+        ),
+        vouch,
+    })
+}
+
+/// How many samples either side of an impact's onset the leave-out re-fit of
+/// [`exits_only_misfit`] leaves out: the ±2 samples whose residuals stood out
+/// ([`checks::structured_impacts`]) and one more.
+const LEAVE_OUT_SAMPLES: f64 = 3.0;
+
+/// The largest move of a peak, as a fraction of its u, that the leave-out
+/// re-fit of [`exits_only_misfit`] allows: the largest the twentieth session
+/// measured on exits whose peaks were not read from there (0.3; most moved by
+/// less than 0.1).
+const LEAVE_OUT_MOVE: f64 = 0.3;
+
+/// Residuals that stand out where the model's exits are not the wall's
+/// ([`exits_only_misfit`]).
+struct Misfit {
+    note: String,
+    /// The onsets to leave out where the peaks must be shown not to depend
+    /// on them (an entry stands out too); `None` for exits only.
+    vouch: Option<Vec<f64>>,
+}
+
+impl Misfit {
+    /// Whether the fit re-fitted without the samples within
+    /// ±[`LEAVE_OUT_SAMPLES`] of the onsets moves no peak by more than
+    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s). A re-fit that fails vouches
+    /// for nothing.
+    fn vouched(&self, fit: &SegmentFit, u: &[f64], dt: f64) -> bool {
+        let Some(onsets) = &self.vouch else { return true };
+        fit.peaks_without(onsets, LEAVE_OUT_SAMPLES * dt, u.len()).is_some_and(|moved| {
+            let peaks = fit.impacts();
+            moved
+                .iter()
+                .zip(&peaks)
+                .zip(u)
+                .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk)
+        })
+    }
 }
 
 /// What the report says of an estimated low-pass that rounds the impacts as
@@ -611,8 +672,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
     let resid = fit.residuals();
-    let model_note = exits_only_misfit(&fit, &resid, phys, p.dt, p.sigma);
-    let exits_misfit = model_note.is_some();
+    let misfit = exits_only_misfit(&fit, &resid, phys, p.dt, p.sigma);
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
     let fit_cov = peak_cov.map(|pc| {
@@ -623,44 +683,59 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         }
         c
     });
-    let cov = fit_cov.clone().map(|mut c| {
-        if !fit.contacts {
-            uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
-        }
-        // The two models of the contacts: their spread is partly shared by
-        // the peaks, and not at all where the model misses the log at exits
-        // (`exits_only_misfit`).
-        let s = if exits_misfit {
-            1.0 / 3f64.sqrt()
-        } else if phys.rocking == Rocking::OneSided {
-            uncertainty::PEAK_TO_PEAK_ONE_SIDED
-        } else {
-            uncertainty::PEAK_TO_PEAK_TWO_SIDED
-        };
-        if let Some(alt) = &fit.alternative {
-            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
-        }
-        if let Some(alt) = &fit.rival_minimum {
-            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
-        }
-        if let Some(alt) = &fit.leaning {
-            uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
-        }
-        uncertainty::add_zero_spread(&mut c, &spread);
-        if let Some((est, cutoff)) = &fit.estimated {
-            acquisition::add_cutoff_spread(&mut c, cutoff);
-            if let Some((_, other)) = &est.runner_up {
-                uncertainty::add_model_spread(&mut c, &impacts, other);
+    let build_cov = |exits_misfit: bool| {
+        fit_cov.clone().map(|mut c| {
+            if !fit.contacts {
+                uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
             }
-            match &est.contact_rival {
-                Some((other, _)) if est.wide_rounding => uncertainty::add_model_alternative(&mut c, &impacts, other),
-                Some((other, _)) => uncertainty::add_model_spread(&mut c, &impacts, other),
-                None => {}
+            // The two models of the contacts: their spread is partly shared by
+            // the peaks, and not at all where the model misses the log at exits
+            // (`exits_only_misfit`).
+            let s = if exits_misfit {
+                1.0 / 3f64.sqrt()
+            } else if phys.rocking == Rocking::OneSided {
+                uncertainty::PEAK_TO_PEAK_ONE_SIDED
+            } else {
+                uncertainty::PEAK_TO_PEAK_TWO_SIDED
+            };
+            if let Some(alt) = &fit.alternative {
+                uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
             }
-        }
-        c
+            if let Some(alt) = &fit.rival_minimum {
+                uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
+            }
+            if let Some(alt) = &fit.leaning {
+                uncertainty::add_model_spread_partly(&mut c, &impacts, alt, s);
+            }
+            uncertainty::add_zero_spread(&mut c, &spread);
+            if let Some((est, cutoff)) = &fit.estimated {
+                acquisition::add_cutoff_spread(&mut c, cutoff);
+                if let Some((_, other)) = &est.runner_up {
+                    uncertainty::add_model_spread(&mut c, &impacts, other);
+                }
+                match &est.contact_rival {
+                    Some((other, _)) if est.wide_rounding => uncertainty::add_model_alternative(&mut c, &impacts, other),
+                    Some((other, _)) => uncertainty::add_model_spread(&mut c, &impacts, other),
+                    None => {}
+                }
+            }
+            c
+        })
+    };
+    let mut cov = build_cov(misfit.is_some());
+    // An entry among the misfits: the peaks must not depend on its samples
+    // (the variances do not depend on how the model-form terms correlate).
+    let misfit = misfit.filter(|m| {
+        let u: Vec<f64> = cov
+            .as_ref()
+            .map_or_else(Vec::new, |c| (0..n_peaks.min(c.len())).map(|k| c[k][k].max(0.0).sqrt()).collect());
+        m.vouched(&fit, &u, p.dt)
     });
-    let mut cov = cov;
+    let exits_misfit = misfit.is_some();
+    if !exits_misfit {
+        cov = build_cov(false);
+    }
+    let model_note = misfit.map(|m| m.note);
     let mut peaks: Vec<Peak> = impacts
         .iter()
         .take(n_peaks)

@@ -247,6 +247,17 @@ impl SegmentFit {
         out
     }
 
+    /// The first `n` peaks of the chosen model re-fitted without the samples
+    /// within `half_width` (s) of any of `onsets` (mm/s; `None` where the
+    /// re-fit fails): how far the peaks depend on those samples
+    /// (`peaks::exits_only_misfit`).
+    pub fn peaks_without(&self, onsets: &[f64], half_width: f64, n: usize) -> Option<Vec<f64>> {
+        let keep = |t: &f64| onsets.iter().all(|o| (t - o).abs() > half_width);
+        let (tw, yw): (Vec<f64>, Vec<f64>) = self.tw.iter().zip(&self.yw).filter(|(t, _)| keep(t)).unzip();
+        let f = fit_model(self.model().clone(), &tw, &yw, 100)?;
+        Some((0..n.min(f.model.m())).map(|k| f.model.peak(k).1).collect())
+    }
+
     /// Residuals of the chosen fit over its window.
     pub fn residuals(&self) -> Vec<f64> {
         let mut r = Vec::new();

@@ -107,7 +107,7 @@ pub fn advice(kind: Kind) -> Advice {
         Kind::ImpactResiduals => Advice {
             title: "The log around an impact is not where the fit puts it.",
             look: "the displacement panel of the motion plot, zoomed on the impact named.",
-            how_far: "On 200 synthetic tests with compliant contacts, the 9 flagged for this were off by 2.20 pp at the median and 7.18 pp at worst (the worst of the seven values of each test). On a one-sided wall, residuals that stand out only where the wall leaves the transverse walls are not a reason (the peaks are not read from there; docs/estimator.md); around an entry they are.",
+            how_far: "On 200 synthetic tests with compliant contacts, the 9 flagged for this were off by 2.20 pp at the median and 7.18 pp at worst (the worst of the seven values of each test). On a one-sided wall, residuals that stand out only where the wall leaves the transverse walls are not a reason (the peaks are not read from there; docs/estimator.md); around an entry they are, unless the entry comes right after such an exit and the peaks do not move when the fit leaves out the samples around both.",
             rerun: "look for a spike or a dropout near the impact in the raw log; a higher logging rate helps.",
         },
         Kind::Disagreement => Advice {

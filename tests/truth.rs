@@ -251,6 +251,36 @@ fn a_push_the_global_fit_does_not_determine_is_read_by_the_contact_model() {
     assert_values_within(r, &truth, "Q1_140_1", 0.01);
 }
 
+/// A push whose two global readings of where its half-cycle ends disagree
+/// (`checks::zero_readings_disagree`) is a reason only while the global fit
+/// reads it. `mujoco-one-sided-unsettled-push`: Q1_170_1 of the public-like
+/// stand-in seed 1405 (200 Hz), whose peak 5 moves by +55.3 mm/s (26 %)
+/// between the fitted zero and the rest line. Until the twenty-fifth session
+/// that flagged it, its values within 0.64 pp of the truth; the contact model
+/// reads its three pushes to the noise (−0.9, +0.9 and +1.6 % of the truth),
+/// and now does: ok, every value within 1 pp (measured 0.76 pp) and 2 u.
+/// Where the contact model does not read the pushes the reason stays:
+/// `mujoco-one-sided-unsettled-push-100hz` (seed 1409's Q1_155_1, 100 Hz,
+/// peak 1 moves by more than half of itself) is suspect for it.
+#[test]
+fn an_unsettled_push_flags_a_test_only_while_the_global_fit_reads_it() {
+    use rocklab::report::quality::{kind, split, Kind};
+    let (res, truth) = reduced_with_truth("mujoco-one-sided-unsettled-push");
+    let r = res.tests[0].result.as_ref().unwrap();
+    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
+    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
+    assert!(r.analysis.deferred_reason.is_none());
+    assert_values_within(r, &truth, "Q1_170_1", 0.01);
+    let (res, _) = reduced_with_truth("mujoco-one-sided-unsettled-push-100hz");
+    let r = res.tests[0].result.as_ref().unwrap();
+    let why = r.suspect_reason().expect("suspect");
+    assert!(
+        split(&why).into_iter().any(|w| kind(w) == Kind::ZeroReadings && w.starts_with("peak 1 ")),
+        "{why}"
+    );
+    assert!(r.analysis.contact_model_peaks().is_empty());
+}
+
 /// A one-sided test whose residuals stand out where the wall leaves the
 /// transverse walls (impact 3, 11.3 σ) and at the entry right after it
 /// (impact 4, 8.1 σ): `mujoco-one-sided-entry-after-exit`, Q1_140_1 of the

@@ -12,7 +12,7 @@
 //! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`); not on a one-sided fit with contact phases and no filter where they stand out around exit impacts only (`peaks::exits_only_misfit`) |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |
-//! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 % |
+//! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 %; on a one-sided push (k odd, contact phases, no filter) only where the contact model does not read the pushes (`inward.rs`) |
 //! | [`undetermined_parameters`] | a peak read from the global fit depends on a direction of its parameters that the log does not determine and does not bound (its uncertainty cannot be computed) |
 //! | [`not_a_covariance`] | the peaks' covariance is not finite, symmetric and positive semi-definite with a positive variance for every peak |
 //! | [`disagreement`] | the local re-fit of an arc's end disagrees with the global fit by more than 4 combined standard uncertainties + 3 % |

@@ -266,6 +266,12 @@ pub struct Analysis {
     /// (`segments::leaning_contacts`), what and what was done about it: the
     /// report and summary.json say so.
     pub model_note: Option<String>,
+    /// A reason that holds only while the pushes of a one-sided log keep the
+    /// global fit's reading: a push whose two readings of where its
+    /// half-cycle ends disagree ([`checks::zero_readings_disagree`] on an odd
+    /// peak). [`analyse`] adds it to `quality` unless the contact model reads
+    /// the pushes ([`inward`]); it is `None` once [`analyse`] returns.
+    pub deferred_reason: Option<String>,
 }
 
 pub use local::ReadingMethod;
@@ -379,8 +385,10 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
         Method::Segments => by_segments(t, prepared, phys, opts).map(|mut a| {
-            if phys.rocking == crate::wall::Rocking::OneSided {
-                inward::read_inward_peaks(&mut a, t, phys.lever_arm_mm);
+            let replaced = phys.rocking == crate::wall::Rocking::OneSided && inward::read_inward_peaks(&mut a, t, phys.lever_arm_mm);
+            let deferred = a.deferred_reason.take();
+            if !replaced {
+                a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(deferred);
             }
             a
         }),
@@ -480,6 +488,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         acquisition_note: None,
         contact_readings: None,
         model_note: None,
+        deferred_reason: None,
     }
 }
 
@@ -758,7 +767,33 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         }
         late_readings(t, &p, phys, &fit, n_peaks)
     };
-    let verdict = quality::plausibility(&fit, &resid, &peaks, &local, &spread, &methods, (p.dt, p.sigma), exits_misfit, &late);
+    // A push whose zero readings disagree is a reason only if the contact
+    // model does not read the pushes (`inward`, after this fit): deferred.
+    let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
+    let (spread_checked, deferred_reason) = if pushes_rereadable {
+        let odd: Vec<f64> = spread.iter().enumerate().map(|(k, &d)| if k % 2 == 1 { d } else { 0.0 }).collect();
+        let even: Vec<f64> = spread.iter().enumerate().map(|(k, &d)| if k % 2 == 1 { 0.0 } else { d }).collect();
+        let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
+        let global: Vec<f64> = odd
+            .iter()
+            .enumerate()
+            .map(|(k, &d)| if methods.get(k) == Some(&ReadingMethod::LocalExtreme) { 0.0 } else { d })
+            .collect();
+        (even, checks::zero_readings_disagree(&v, &global))
+    } else {
+        (spread.clone(), None)
+    };
+    let verdict = quality::plausibility(
+        &fit,
+        &resid,
+        &peaks,
+        &local,
+        &spread_checked,
+        &methods,
+        (p.dt, p.sigma),
+        exits_misfit,
+        &late,
+    );
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
     let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):
@@ -800,5 +835,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             .or_else(|| fit.estimated.as_ref().and_then(|(e, _)| wide_rounding_note(e, p.dt))),
         contact_readings: None,
         model_note: model_note.or_else(|| fit.leaning.as_ref().map(|_| LEANING_NOTE.to_string())),
+        deferred_reason,
     })
 }

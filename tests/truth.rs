@@ -22,6 +22,17 @@ fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_jso
     (reduce_campaign(load_campaign(name, false), PeakOptions::default()), truth)
 }
 
+/// The one-test fixture campaign `name` (a one-sided MuJoCo stand-in's test
+/// alone), checked to be ok with its pushes (peaks 1, 3, 5) read by the
+/// contact model (`src/peaks/inward.rs`); with its truth.
+fn ok_with_pushes_read_by_the_contact_model(name: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
+    let (res, truth) = reduced_with_truth(name);
+    let r = res.tests[0].result.as_ref().unwrap();
+    assert!(r.analysis.quality.is_ok(), "{name}: {}", r.analysis.quality.describe());
+    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5], "{name}");
+    (res, truth)
+}
+
 /// Test `id` of the fixture campaign `name` reduced alone (a campaign of that
 /// one test: no other test to say what its wall's contacts are), with the
 /// campaign's truth.
@@ -243,11 +254,8 @@ fn the_pushes_peaks_are_read_by_the_contact_model() {
 /// (measured; its error −1.7 %).
 #[test]
 fn a_push_the_global_fit_does_not_determine_is_read_by_the_contact_model() {
-    let (res, truth) = reduced_with_truth("mujoco-one-sided-undetermined-exit");
-    let t = &res.tests[0];
-    let r = t.result.as_ref().unwrap();
-    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
-    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
+    let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-undetermined-exit");
+    let r = res.tests[0].result.as_ref().unwrap();
     let p3 = r.analysis.peaks[3];
     let u3 = p3.velocity_u_mm_s.unwrap() / p3.velocity_mm_s.abs();
     assert!(u3 < 0.10, "peak 3 at ± {:.1} %", 100.0 * u3);
@@ -269,10 +277,8 @@ fn a_push_the_global_fit_does_not_determine_is_read_by_the_contact_model() {
 /// 0.62 pp) and 2 u.
 #[test]
 fn pushes_the_global_fit_does_not_read_carry_the_contact_readings_u() {
-    let (res, truth) = reduced_with_truth("mujoco-one-sided-undetermined-pushes");
+    let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-undetermined-pushes");
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
-    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
     for k in [1, 3, 5] {
         let p = r.analysis.peaks[k];
         let u = p.velocity_u_mm_s.unwrap() / p.velocity_mm_s.abs();
@@ -295,10 +301,8 @@ fn pushes_the_global_fit_does_not_read_carry_the_contact_readings_u() {
 #[test]
 fn an_unsettled_push_flags_a_test_only_while_the_global_fit_reads_it() {
     use rocklab::report::quality::{kind, split, Kind};
-    let (res, truth) = reduced_with_truth("mujoco-one-sided-unsettled-push");
+    let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-unsettled-push");
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
-    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
     assert!(r.analysis.deferred_reason.is_none());
     assert_values_within(r, &truth, "Q1_170_1", 0.01);
     let (res, _) = reduced_with_truth("mujoco-one-sided-unsettled-push-100hz");
@@ -322,15 +326,13 @@ fn an_unsettled_push_flags_a_test_only_while_the_global_fit_reads_it() {
 /// value is within 0.3 pp (measured 0.26 pp) and 2 u.
 #[test]
 fn residuals_at_an_exit_and_the_entry_after_it_do_not_flag_a_test_whose_peaks_do_not_depend_on_them() {
-    let (res, truth) = reduced_with_truth("mujoco-one-sided-entry-after-exit");
+    let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-entry-after-exit");
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
     let note = r.analysis.model_note.as_deref().unwrap_or_default();
     assert!(
         note.contains("impact 3") && note.contains("impact 4") && note.contains("the entry after it"),
         "{note}"
     );
-    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
     assert_values_within(r, &truth, "Q1_140_1", 0.003);
 }
 

@@ -335,25 +335,37 @@ mod tests {
         assert_eq!(a.methods[2], ReadingMethod::KinkModel);
     }
 
+    /// Peaks −500, 400, −350, 300, −260, 220 at u 5 (covariance 12.5), the
+    /// global fit's own part 9 on every peak (covariance 4) but peak 3's,
+    /// whose own variance is `own_3`; its u² is 16 + `own_3`.
+    fn with_own_part(own_3: f64) -> Analysis {
+        let mut a = analysis(&[-500.0, 400.0, -350.0, 300.0, -260.0, 220.0], 5.0);
+        let mut own: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| if i == j { 9.0 } else { 4.0 }).collect()).collect();
+        own[3][3] = own_3;
+        a.fit_covariance = Some(own);
+        a.peak_covariance.as_mut().unwrap()[3][3] = 16.0 + own_3;
+        a.peaks[3].velocity_u_mm_s = Some((16.0 + own_3).sqrt());
+        a
+    }
+
+    /// Replace peaks 1, 3, 5 by contact readings of `speeds` at u 1 that fit
+    /// the samples to the noise.
+    fn replace_at_the_noise(a: &mut Analysis, speeds: [f64; 3]) {
+        let read: Vec<ContactPeak> = [1, 3, 5].iter().zip(speeds).map(|(&k, v)| reading(k, v, 1.0, 50.0)).collect();
+        let new = replacements(a, &read).expect("replaced");
+        apply(a, &new);
+    }
+
     /// The global fit's own part of a replaced peak's variance and of its
     /// covariances goes; the model-form part stays, and the contact reading's
     /// own variance comes in: a global u dominated by a direction the global
     /// fit does not determine no longer sets the replaced peak's u.
     #[test]
     fn the_global_fits_statistical_part_is_swapped_for_the_readings() {
-        let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
-        let mut a = analysis(&v, 5.0);
         // Own part: variance 9 on every peak, covariance 4; peak 3's own
         // variance 400 (± 20 from an undetermined direction), so u_g(3) = √416.
-        let mut own: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| if i == j { 9.0 } else { 4.0 }).collect()).collect();
-        own[3][3] = 400.0;
-        a.fit_covariance = Some(own);
-        let cov = a.peak_covariance.as_mut().unwrap();
-        cov[3][3] = 16.0 + 400.0;
-        a.peaks[3].velocity_u_mm_s = Some(416f64.sqrt());
-        let read = [reading(1, 408.0, 1.0, 50.0), reading(3, 303.0, 1.0, 50.0), reading(5, 221.0, 1.0, 50.0)];
-        let new = replacements(&a, &read).expect("replaced");
-        apply(&mut a, &new);
+        let mut a = with_own_part(400.0);
+        replace_at_the_noise(&mut a, [408.0, 303.0, 221.0]);
         // Peak 3: the swapped u² = 416 − 400 + 1 = 17 beats √(1 + 9) = √10.
         assert!((a.peaks[3].velocity_u_mm_s.unwrap() - 17f64.sqrt()).abs() < 1e-12);
         // Peak 1: swapped 25 − 9 + 1 = 17 < 1 + 64, so u = √65, and its
@@ -377,18 +389,9 @@ mod tests {
     /// and it has no correlation; the pushes the fit reads keep theirs.
     #[test]
     fn a_push_the_global_fit_does_not_read_is_the_contact_readings_alone() {
-        let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
-        let mut a = analysis(&v, 5.0);
-        let mut own: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| if i == j { 9.0 } else { 4.0 }).collect()).collect();
         // Peak 3: own u 300 (100 % of its speed), global u √(90000 + 16).
-        own[3][3] = 90_000.0;
-        a.fit_covariance = Some(own);
-        let cov = a.peak_covariance.as_mut().unwrap();
-        cov[3][3] = 90_016.0;
-        a.peaks[3].velocity_u_mm_s = Some(90_016f64.sqrt());
-        let read = [reading(1, 408.0, 1.0, 50.0), reading(3, 303.0, 1.0, 50.0), reading(5, 221.0, 1.0, 50.0)];
-        let new = replacements(&a, &read).expect("replaced");
-        apply(&mut a, &new);
+        let mut a = with_own_part(90_000.0);
+        replace_at_the_noise(&mut a, [408.0, 303.0, 221.0]);
         // u² = 1 + (0.01 × 303)² + max(0, 3² − 90000) = 10.1809.
         let u3 = (1.0 + 3.03f64.powi(2)).sqrt();
         assert!((a.peaks[3].velocity_u_mm_s.unwrap() - u3).abs() < 1e-12);

@@ -561,7 +561,7 @@ fn unfiltered_contacts(fit: &SegmentFit) -> bool {
 /// spread: the free arc between them starts where the model's exit put it)
 /// and the peaks do not depend on the samples of either: re-fitted without
 /// the samples within ±[`LEAVE_OUT_SAMPLES`] of every impact that stands out,
-/// no peak moves by more than [`LEAVE_OUT_MOVE`] of its u ([`Misfit::vouch`],
+/// no peak moves by more than [`LEAVE_OUT_MOVE`] of its u ([`Misfit::vouched`],
 /// twenty-fifth session, docs/estimator.md).
 /// Returns the note the report gives where it applies, and whether the
 /// leave-out re-fit must vouch for it.
@@ -622,10 +622,13 @@ struct Misfit {
 impl Misfit {
     /// Whether the fit re-fitted without the samples within
     /// ±[`LEAVE_OUT_SAMPLES`] of the onsets moves no peak by more than
-    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s). A re-fit that fails vouches
-    /// for nothing.
+    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s). A re-fit that fails, or
+    /// peaks without a u, vouch for nothing.
     fn vouched(&self, fit: &SegmentFit, u: &[f64], dt: f64) -> bool {
         let Some(onsets) = &self.vouch else { return true };
+        if u.is_empty() {
+            return false;
+        }
         fit.peaks_without(onsets, LEAVE_OUT_SAMPLES * dt, u.len()).is_some_and(|moved| {
             let peaks = fit.impacts();
             moved
@@ -731,7 +734,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             c
         })
     };
-    let mut cov = build_cov(misfit.is_some());
+    let tried = misfit.is_some();
+    let mut cov = build_cov(tried);
     // An entry among the misfits: the peaks must not depend on its samples
     // (the variances do not depend on how the model-form terms correlate).
     let misfit = misfit.filter(|m| {
@@ -741,7 +745,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         m.vouched(&fit, &u, p.dt)
     });
     let exits_misfit = misfit.is_some();
-    if !exits_misfit {
+    if tried && !exits_misfit {
         cov = build_cov(false);
     }
     let model_note = misfit.map(|m| m.note);
@@ -771,15 +775,16 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // model does not read the pushes (`inward`, after this fit): deferred.
     let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
     let (spread_checked, deferred_reason) = if pushes_rereadable {
-        let odd: Vec<f64> = spread.iter().enumerate().map(|(k, &d)| if k % 2 == 1 { d } else { 0.0 }).collect();
-        let even: Vec<f64> = spread.iter().enumerate().map(|(k, &d)| if k % 2 == 1 { 0.0 } else { d }).collect();
+        let pick = |push: bool| -> Vec<f64> {
+            let global = |k: usize| methods.get(k) != Some(&ReadingMethod::LocalExtreme);
+            spread
+                .iter()
+                .enumerate()
+                .map(|(k, &d)| if (k % 2 == 1) == push && global(k) { d } else { 0.0 })
+                .collect()
+        };
         let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
-        let global: Vec<f64> = odd
-            .iter()
-            .enumerate()
-            .map(|(k, &d)| if methods.get(k) == Some(&ReadingMethod::LocalExtreme) { 0.0 } else { d })
-            .collect();
-        (even, checks::zero_readings_disagree(&v, &global))
+        (pick(false), checks::zero_readings_disagree(&v, &pick(true)))
     } else {
         (spread.clone(), None)
     };

@@ -162,13 +162,14 @@ fn replacements(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> 
             // Without the fit's own part (never so from `analyse`) u_g stays whole.
             let own = a.fit_covariance.as_ref().map(|f| f[k][k].clamp(0.0, u_g * u_g));
             let swapped = own.map_or(u_g, |own| (u_g * u_g - own + c.reading.u_mm_s.powi(2)).sqrt());
-            let independent = own.is_some_and(|own| own.sqrt() > UNDETERMINED * global.velocity_mm_s.abs());
-            let u = if independent {
-                let form = crate::impacts::CONTACT_READING_FORM * c.reading.velocity_mm_s;
-                let unexplained = (d * d - own.unwrap_or(0.0)).max(0.0);
-                (c.reading.u_mm_s.powi(2) + form * form + unexplained).sqrt()
-            } else {
-                swapped.max(c.reading.u_mm_s.hypot(d))
+            // The global fit's own variance of a push it does not read.
+            let undetermined = own.filter(|own| own.sqrt() > UNDETERMINED * global.velocity_mm_s.abs());
+            let u = match undetermined {
+                Some(own) => {
+                    let form = crate::impacts::CONTACT_READING_FORM * c.reading.velocity_mm_s;
+                    (c.reading.u_mm_s.powi(2) + form * form + (d * d - own).max(0.0)).sqrt()
+                }
+                None => swapped.max(c.reading.u_mm_s.hypot(d)),
             };
             (same_sign && u.is_finite()).then_some(Replacement {
                 k,
@@ -176,7 +177,7 @@ fn replacements(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> 
                 velocity_mm_s: c.reading.velocity_mm_s,
                 u_mm_s: u,
                 swapped_mm_s: swapped,
-                independent,
+                independent: undetermined.is_some(),
             })
         })
         .collect::<Option<Vec<_>>>()?;
@@ -195,8 +196,9 @@ fn apply(a: &mut Analysis, new: &[Replacement]) {
     }
     for r in new {
         let p = &mut a.peaks[r.k];
-        // A global u of 0 has no correlations to keep: the row and column
-        // become the new reading's own variance.
+        // A global u of 0 has no correlations to keep, and a push the global
+        // fit does not read takes none: the row and column become the new
+        // reading's own variance.
         let scale = p.velocity_u_mm_s.filter(|&u| u > 0.0 && !r.independent).map(|u| r.u_mm_s / u);
         p.time_s = r.time_s;
         p.velocity_mm_s = r.velocity_mm_s;

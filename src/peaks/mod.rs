@@ -573,7 +573,7 @@ fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, s
     let onsets: Vec<f64> = (0..m.m()).map(|k| m.onset(k)).collect();
     let standing_out = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
     let after_exit = |k: usize, r: f64| k > 0 && standing_out.iter().any(|&(j, rj)| j + 1 == k && rj > r);
-    let entries: Vec<usize> = standing_out.iter().filter(|(k, _)| k % 2 == 0).map(|&(k, _)| k).collect();
+    let with_entry = standing_out.iter().any(|(k, _)| k % 2 == 0);
     if standing_out.is_empty() || standing_out.iter().any(|&(k, r)| k % 2 == 0 && !after_exit(k, r)) {
         return None;
     }
@@ -581,14 +581,14 @@ fn exits_only_misfit(fit: &SegmentFit, resid: &[f64], phys: &Physics, dt: f64, s
         .iter()
         .map(|(k, r)| format!("impact {k}, {:.1} × the noise", r / sigma))
         .collect();
-    let vouch = (!entries.is_empty()).then(|| standing_out.iter().map(|&(k, _)| onsets[k]).collect());
-    let (where_, left_out) = if entries.is_empty() {
-        ("where the wall leaves the transverse walls", "")
-    } else {
+    let vouch = with_entry.then(|| standing_out.iter().map(|&(k, _)| onsets[k]).collect());
+    let (where_, left_out) = if with_entry {
         (
             "where the wall leaves the transverse walls and at the entry after it",
             &*format!(", re-fitted without the samples around them no peak moves by more than {LEAVE_OUT_MOVE} of its u"),
         )
+    } else {
+        ("where the wall leaves the transverse walls", "")
     };
     Some(Misfit {
         note: format!(
@@ -622,18 +622,17 @@ struct Misfit {
 impl Misfit {
     /// Whether the fit re-fitted without the samples within
     /// ±[`LEAVE_OUT_SAMPLES`] of the onsets moves no peak by more than
-    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s). A re-fit that fails, or
-    /// peaks without a u, vouch for nothing.
-    fn vouched(&self, fit: &SegmentFit, u: &[f64], dt: f64) -> bool {
+    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s) from the fit's `impacts`.
+    /// A re-fit that fails, or peaks without a u, vouch for nothing.
+    fn vouched(&self, fit: &SegmentFit, impacts: &[Impact], u: &[f64], dt: f64) -> bool {
         let Some(onsets) = &self.vouch else { return true };
         if u.is_empty() {
             return false;
         }
         fit.peaks_without(onsets, LEAVE_OUT_SAMPLES * dt, u.len()).is_some_and(|moved| {
-            let peaks = fit.impacts();
             moved
                 .iter()
-                .zip(&peaks)
+                .zip(impacts)
                 .zip(u)
                 .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk)
         })
@@ -742,7 +741,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         let u: Vec<f64> = cov
             .as_ref()
             .map_or_else(Vec::new, |c| (0..n_peaks.min(c.len())).map(|k| c[k][k].max(0.0).sqrt()).collect());
-        m.vouched(&fit, &u, p.dt)
+        m.vouched(&fit, &impacts, &u, p.dt)
     });
     let exits_misfit = misfit.is_some();
     if tried && !exits_misfit {

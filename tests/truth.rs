@@ -840,7 +840,13 @@ fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
             r.analysis.quality.describe()
         );
         if std::env::var("ENGINE_DETAIL").is_ok() {
-            let values: Vec<String> = errors_pp(&v, e_h, tt).iter().map(|(k, e)| format!("{k} {e:+.2}")).collect();
+            let u = r.uncertainty.map(|u| serde_json::to_value(u).unwrap());
+            let u_pp = |k: &str| {
+                u.as_ref()
+                    .and_then(|u| u[k].as_f64())
+                    .map_or(String::new(), |x| format!("±{:.2}", 100.0 * x))
+            };
+            let values: Vec<String> = errors_pp(&v, e_h, tt).iter().map(|(k, e)| format!("{k} {e:+.2}{}", u_pp(k))).collect();
             println!("    values (pp): {}", values.join(", "));
             print_readings(&t.spec.id, r, t.spec.lever_arm_m * 1000.0, &true_v);
         }

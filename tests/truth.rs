@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use rocklab::ingest::Campaign;
-use rocklab::peaks::PeakOptions;
+use rocklab::peaks::{late, PeakOptions};
 use rocklab::reduce::reduce_campaign;
 
 const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
@@ -860,8 +860,9 @@ fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
 }
 
 /// Each of the first six peaks of one test as read locally (smooth extreme,
-/// kink at the crossing) and by the global fit's arc-end re-fit, in % of the
-/// truth (`ENGINE_DETAIL` set).
+/// kink at the crossing), by the global fit's arc-end re-fit and, on one-sided
+/// logs, by the contact model ("misfit" where it does not fit the samples to
+/// the noise), in % of the truth (`ENGINE_DETAIL` set).
 fn print_readings(id: &str, r: &rocklab::reduce::Reduced, lever_mm: f64, true_v: &[f64]) {
     let late = r.analysis.late_peaks(&r.log.time_s, lever_mm, 0, 6);
     let a = &r.analysis;
@@ -881,15 +882,26 @@ fn print_readings(id: &str, r: &rocklab::reduce::Reduced, lever_mm: f64, true_v:
             .map(|i| i.v_after_mm_s.map_or(f64::NAN, |v| (v / i.v_before_mm_s * 1000.0).round() / 1000.0))
             .collect::<Vec<_>>()
     );
+    // The contact model's readings of the test's peaks (one-sided logs whose
+    // fit found the small arc), read over 12 peaks as `peaks::inward` reads
+    // them (its PEAKS_READ), so that the restraint is the one its rule used.
+    let contacts = match (a.lambda_fit.is_some(), a.small_arc) {
+        (true, Some(arc)) => late::contact_peaks(a, &r.log.time_s, lever_mm, arc, 12, late::CONTACT_POST_S),
+        _ => Vec::new(),
+    };
     for (k, &vt) in true_v.iter().take(6).enumerate() {
         let pc = |v: f64, u: f64| format!("{:+.1}%±{:.1}", 100.0 * (v / vt - 1.0), 100.0 * u / vt.abs());
         let p = late.iter().find(|p| p.k == k);
         let smooth = p.and_then(|p| p.smooth).map_or("-".into(), |x| pc(x.velocity_mm_s, x.u_mm_s));
         let kink = p.and_then(|p| p.kink).map_or("-".into(), |x| pc(x.velocity_mm_s, x.u_mm_s));
         let arc = r.analysis.local_peaks.get(k).copied().flatten().map_or("-".into(), |(v, u)| pc(v, u));
+        let contact = contacts.iter().find(|p| p.k == k).and_then(|p| p.reading).map_or("-".into(), |x| {
+            let fits = if x.fits_noise() { "" } else { " misfit" };
+            format!("{}{fits}", pc(x.reading.velocity_mm_s, x.reading.u_mm_s))
+        });
         let g = &r.analysis.peaks[k];
         println!(
-            "    k{k}: global {}  smooth {smooth}  kink {kink}  arc-end {arc}",
+            "    k{k}: global {}  smooth {smooth}  kink {kink}  arc-end {arc}  contact {contact}",
             pc(g.velocity_mm_s, g.velocity_u_mm_s.unwrap_or(0.0))
         );
     }

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use rocklab::ingest::Campaign;
-use rocklab::peaks::{late, PeakOptions};
+use rocklab::peaks::{inward, late, PeakOptions};
 use rocklab::reduce::reduce_campaign;
 
 const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
@@ -883,10 +883,10 @@ fn print_readings(id: &str, r: &rocklab::reduce::Reduced, lever_mm: f64, true_v:
             .collect::<Vec<_>>()
     );
     // The contact model's readings of the test's peaks (one-sided logs whose
-    // fit found the small arc), read over 12 peaks as `peaks::inward` reads
-    // them (its PEAKS_READ), so that the restraint is the one its rule used.
+    // fit found the small arc), over as many peaks as `peaks::inward` reads,
+    // so that the restraint is the one its rule used.
     let contacts = match (a.lambda_fit.is_some(), a.small_arc) {
-        (true, Some(arc)) => late::contact_peaks(a, &r.log.time_s, lever_mm, arc, 12, late::CONTACT_POST_S),
+        (true, Some(arc)) => late::contact_peaks(a, &r.log.time_s, lever_mm, arc, inward::PEAKS_READ, late::CONTACT_POST_S),
         _ => Vec::new(),
     };
     for (k, &vt) in true_v.iter().take(6).enumerate() {

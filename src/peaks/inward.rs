@@ -89,7 +89,7 @@ use super::{Analysis, ReadingMethod};
 /// restraint's (λ, ω) is fitted over every push the log resolves, so the
 /// readings are those of the per-impact table, which reuses them
 /// ([`Analysis::contact_readings`]).
-pub(crate) const PEAKS_READ: usize = 12;
+pub const PEAKS_READ: usize = 12;
 
 /// Replace the odd peaks of a one-sided analysis by their contact readings
 /// (module docs). Returns whether it did. The caller decides that the wall is

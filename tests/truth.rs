@@ -544,11 +544,64 @@ fn a_filter_and_failing_contacts_leave_the_test_suspect() {
             assert_eq!(r.analysis.response.source, "estimated", "the test's own reading is kept");
             let why = r.suspect_reason().expect("suspect");
             assert!(split(&why).into_iter().map(kind).any(|k| k == Kind::FilterUnknown), "{why}");
-            for named in ["bessel", "compliant contacts", "3 of the campaign's 4 tests", "filter = \"none\""] {
+            for named in [
+                "bessel",
+                "compliant contacts",
+                "3 of the campaign's 3 tests with status ok and no estimated filter",
+                "filter = \"none\"",
+            ] {
                 assert!(why.contains(named), "{why}");
             }
         } else {
             assert!(r.analysis.quality.is_ok(), "{}", t.spec.id);
+        }
+    }
+}
+
+/// A test whose filter was only estimated does not vote on whether its wall
+/// shows contacts (`rocklab::reduction::campaign_shows_contacts`): its rounding
+/// is the very thing the filter and the contacts compete for. The case: the
+/// penalty engine's one-sided campaign, seed 3 (no logger filter;
+/// `tools/penalty_campaign.py --preset penalty-one-sided --seed 3`). E1_170_1
+/// and E1_150_1 show their contact phases; E1_160_1 reads as instantaneous
+/// impacts; the 100 Hz E1_155_1 reads as an estimated Bessel 4 at 25 Hz. With
+/// the estimated test counted, 2 of 4 was no majority, and E1_155_1 stayed ok
+/// through a filter the logger never had, r₁ 3.03 pp off (twenty-eighth
+/// session). Without its vote (2 of 3) the campaign rule re-reads it with
+/// contact phases and no filter; that fails its checks, so neither reading is
+/// vouched for and it is suspect; E1_160_1 and E1_140_1 are re-read with the
+/// wall's contacts (E1_140_1, suspect before for the unknown filter, is ok).
+/// Asserted: no ok test keeps an estimated filter, E1_155_1 is suspect for
+/// it, the other four are ok with contact phases, and every value of theirs is
+/// within 2 of its stated u.
+#[test]
+fn a_test_read_through_an_estimated_filter_does_not_vote_on_contacts() {
+    use rocklab::report::quality::{kind, split, Kind};
+    let (res, truth) = reduced_with_truth("penalty-one-sided-s3");
+    for t in &res.tests {
+        let r = t.result.as_ref().unwrap();
+        let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
+        println!(
+            "{} [{}] response {}, contact phases {}",
+            t.spec.id,
+            r.analysis.quality.describe(),
+            r.analysis.response.source,
+            r.analysis.contact_phases
+        );
+        if t.spec.id == "E1_155_1" {
+            let why = r.suspect_reason().expect("E1_155_1 suspect");
+            assert!(split(&why).into_iter().map(kind).any(|k| k == Kind::FilterUnknown), "{why}");
+            continue;
+        }
+        assert!(r.analysis.quality.is_ok() && r.analysis.contact_phases, "{}", t.spec.id);
+        assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
+        let c = serde_json::to_value(r.coefficients).unwrap();
+        let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
+        for k in KEYS {
+            let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
+            let uk = u[k].as_f64().unwrap();
+            println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
+            assert!(err.abs() <= 2.0 * uk, "{} {k}: {err:+.4} ± {uk:.4}", t.spec.id);
         }
     }
 }

@@ -121,6 +121,14 @@ pub fn unresolved_ratios(u: &Coefficients) -> Vec<(&'static str, f64)> {
     out
 }
 
+/// Whether `reason` is one [`unresolved_reason`] gave (ratios read too loosely).
+pub fn is_unresolved_reason(reason: &str) -> bool {
+    reason.starts_with(UNRESOLVED_OPENING)
+}
+
+/// How [`unresolved_reason`]'s reason begins.
+const UNRESOLVED_OPENING: &str = "the log does not resolve ";
+
 /// Why a test's values cannot be vouched for when some ratio exceeds
 /// [`RATIO_U_MAX`]: the ratios and their u, and the first six peaks read to more
 /// than ± 2 [`RATIO_U_MAX`] (relative, from the diagonal of their covariance).
@@ -153,7 +161,7 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
         format!(" ({}: the log has too few samples or too much noise around them)", peaks.join(", "))
     };
     Some(format!(
-        "the log does not resolve {}: a ratio read to more than ± {:.0} pp cannot be vouched for{why}",
+        "{UNRESOLVED_OPENING}{}: a ratio read to more than ± {:.0} pp cannot be vouched for{why}",
         values.join(", "),
         100.0 * RATIO_U_MAX
     ))
@@ -215,6 +223,8 @@ mod tests {
             "{why}"
         );
         assert!(!why.contains("peak"), "no peak is read loosely here: {why}");
+        assert!(is_unresolved_reason(&why));
+        assert!(!is_unresolved_reason("the fit misses the log: the residuals spread 0.1 mm"));
     }
 
     use super::*;

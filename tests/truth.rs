@@ -547,7 +547,7 @@ fn a_filter_and_failing_contacts_leave_the_test_suspect() {
             for named in [
                 "bessel",
                 "compliant contacts",
-                "3 of the campaign's 3 tests with status ok and no estimated filter",
+                "3 of the campaign's 3 tests that can tell",
                 "filter = \"none\"",
             ] {
                 assert!(why.contains(named), "{why}");
@@ -603,6 +603,53 @@ fn a_test_read_through_an_estimated_filter_does_not_vote_on_contacts() {
             println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
             assert!(err.abs() <= 2.0 * uk, "{} {k}: {err:+.4} ± {uk:.4}", t.spec.id);
         }
+    }
+}
+
+/// A test suspect only for ratios read too loosely votes on its wall's
+/// contacts (`rocklab::reduction::campaign_shows_contacts`): its fit passed
+/// every other check, contact phases included. The penalty engine's one-sided
+/// seed 6 (no logger filter): E1_150_1 (1000 Hz) shows contact phases,
+/// E1_155_1 (100 Hz) reads instantaneous impacts, E1_160_1 (500 Hz) shows
+/// them but is suspect for r₁ ± 7.0 pp, and the 200 Hz E1_170_1 and E1_140_1
+/// read as estimated Bessel filters that neither rival check could rule out.
+/// Without E1_160_1's vote, 1 of 2 was no majority and both stayed suspect
+/// (E1_140_1's values up to 3.55 pp off); with it, 2 of 3, and E1_140_1 is read
+/// with the wall's contacts and no filter: ok, within 0.31 pp (twenty-eighth
+/// session). Asserted: E1_140_1 ok with contact phases and no estimated
+/// filter, every value within 1 pp and within 2 of its stated u; no ok test
+/// keeps an estimated filter.
+#[test]
+fn a_test_suspect_only_for_loose_ratios_votes_on_contacts() {
+    let (res, truth) = reduced_with_truth("penalty-one-sided-s6");
+    for t in &res.tests {
+        let r = t.result.as_ref().unwrap();
+        println!(
+            "{} [{}] response {}, contact phases {}",
+            t.spec.id,
+            r.analysis.quality.describe(),
+            r.analysis.response.source,
+            r.analysis.contact_phases
+        );
+        if r.analysis.quality.is_ok() {
+            assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
+        }
+    }
+    let t = res.tests.iter().find(|t| t.spec.id == "E1_140_1").unwrap();
+    let r = t.result.as_ref().unwrap();
+    assert!(
+        r.analysis.quality.is_ok() && r.analysis.contact_phases,
+        "{}",
+        r.analysis.quality.describe()
+    );
+    let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == "E1_140_1").unwrap();
+    let c = serde_json::to_value(r.coefficients).unwrap();
+    let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
+    for k in KEYS {
+        let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
+        let uk = u[k].as_f64().unwrap();
+        println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
+        assert!(err.abs() <= 0.01 && err.abs() <= 2.0 * uk, "{k}: {err:+.4} ± {uk:.4}");
     }
 }
 

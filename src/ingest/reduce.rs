@@ -250,7 +250,7 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
         if fits(&again) {
             t.result = again.result;
             t.warnings.push(format!(
-                "contact phases fitted because {with} of the campaign's {n_ok} tests with status ok and no estimated filter show them; this log alone did not ask for them"
+                "contact phases fitted because {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show them; this log alone did not ask for them"
             ));
             continue;
         }
@@ -276,7 +276,7 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
             }
             t.result = again.result;
             t.warnings.push(format!(
-                "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests with status ok and no estimated filter show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
+                "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
             ));
             continue;
         }
@@ -302,7 +302,7 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, mut tests:
 fn mark_filter_ruled_out(analysis: &mut crate::peaks::Analysis, estimated: &str, with: usize, n_ok: usize) {
     analysis.response.source = "not detected";
     analysis.acquisition_note = Some(format!(
-        "a low-pass ({estimated}) fits the rounding of the impacts, but {with} of the campaign's {n_ok} tests with status ok and no estimated filter show compliant contacts, which round an impact as a low-pass does, and read with contact phases this test passes its checks: no filter modelled"
+        "a low-pass ({estimated}) fits the rounding of the impacts, but {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show compliant contacts, which round an impact as a low-pass does, and read with contact phases this test passes its checks: no filter modelled"
     ));
 }
 
@@ -316,8 +316,8 @@ fn estimated_filter(analysis: &crate::peaks::Analysis) -> String {
 }
 
 /// The reason of a test whose logger filter was only estimated while its
-/// campaign shows contact phases (`with` of its `n_ok` tests with status ok),
-/// and whose reading with contact phases and no filter (`contacts`, its peaks
+/// campaign shows contact phases (`with` of its `n_ok` voting tests,
+/// `reduction::campaign_shows_contacts`), and whose reading with contact phases and no filter (`contacts`, its peaks
 /// if it gave any) fails its checks (docs/estimator.md, "A contact is not a
 /// filter").
 fn neither_reading(filtered: &crate::peaks::Analysis, contacts: Option<&[crate::peaks::Peak]>, with: usize, n_ok: usize) -> String {
@@ -331,6 +331,6 @@ fn neither_reading(filtered: &crate::peaks::Analysis, contacts: Option<&[crate::
         format!(" (the two readings' ratios of consecutive peaks differ by up to {worst:.3})")
     });
     format!(
-        "the logger's filter is not stated and the log cannot tell whether its impacts are rounded by a filter (estimated: {filter}) or by the wall's compliant contacts, as {with} of the campaign's {n_ok} tests with status ok and no estimated filter show, and read with contact phases and no filter this test fails its checks, as it does with filter = \"none\" stated{differ}: state the filter (\"none\" if the logger has none)"
+        "the logger's filter is not stated and the log cannot tell whether its impacts are rounded by a filter (estimated: {filter}) or by the wall's compliant contacts, as {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show, and read with contact phases and no filter this test fails its checks, as it does with filter = \"none\" stated{differ}: state the filter (\"none\" if the logger has none)"
     )
 }

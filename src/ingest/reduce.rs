@@ -317,9 +317,9 @@ fn estimated_filter(analysis: &crate::peaks::Analysis) -> String {
 
 /// The reason of a test whose logger filter was only estimated while its
 /// campaign shows contact phases (`with` of its `n_ok` voting tests,
-/// `reduction::campaign_shows_contacts`), and whose reading with contact phases and no filter (`contacts`, its peaks
-/// if it gave any) fails its checks (docs/estimator.md, "A contact is not a
-/// filter").
+/// `reduction::campaign_shows_contacts`), and whose reading with contact
+/// phases and no filter (`contacts`, its peaks if it gave any) fails its
+/// checks (docs/estimator.md, "A contact is not a filter").
 fn neither_reading(filtered: &crate::peaks::Analysis, contacts: Option<&[crate::peaks::Peak]>, with: usize, n_ok: usize) -> String {
     let filter = estimated_filter(filtered);
     let differ = contacts.map_or(String::new(), |c| {

@@ -558,6 +558,29 @@ fn a_filter_and_failing_contacts_leave_the_test_suspect() {
     }
 }
 
+/// A reduced test's status, response and contact phases, printed.
+fn print_reading(id: &str, r: &rocklab::reduce::Reduced) {
+    println!(
+        "{id} [{}] response {}, contact phases {}",
+        r.analysis.quality.describe(),
+        r.analysis.response.source,
+        r.analysis.contact_phases
+    );
+}
+
+/// Every table value of `r` within 2 of its stated u of the truth's (test
+/// `tt` of a truth.json) and within `max` (absolute), each printed.
+fn assert_values_within_2u(id: &str, r: &rocklab::reduce::Reduced, tt: &serde_json::Value, max: f64) {
+    let c = serde_json::to_value(r.coefficients).unwrap();
+    let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
+    for k in KEYS {
+        let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
+        let uk = u[k].as_f64().unwrap();
+        println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
+        assert!(err.abs() <= 2.0 * uk && err.abs() <= max, "{id} {k}: {err:+.4} ± {uk:.4}");
+    }
+}
+
 /// A test whose filter was only estimated does not vote on whether its wall
 /// shows contacts (`rocklab::reduction::campaign_shows_contacts`): its rounding
 /// is the very thing the filter and the contacts compete for. The case: the
@@ -581,13 +604,7 @@ fn a_test_read_through_an_estimated_filter_does_not_vote_on_contacts() {
     for t in &res.tests {
         let r = t.result.as_ref().unwrap();
         let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == t.spec.id.as_str()).unwrap();
-        println!(
-            "{} [{}] response {}, contact phases {}",
-            t.spec.id,
-            r.analysis.quality.describe(),
-            r.analysis.response.source,
-            r.analysis.contact_phases
-        );
+        print_reading(&t.spec.id, r);
         if t.spec.id == "E1_155_1" {
             let why = r.suspect_reason().expect("E1_155_1 suspect");
             assert!(split(&why).into_iter().map(kind).any(|k| k == Kind::FilterUnknown), "{why}");
@@ -595,14 +612,7 @@ fn a_test_read_through_an_estimated_filter_does_not_vote_on_contacts() {
         }
         assert!(r.analysis.quality.is_ok() && r.analysis.contact_phases, "{}", t.spec.id);
         assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
-        let c = serde_json::to_value(r.coefficients).unwrap();
-        let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
-        for k in KEYS {
-            let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
-            let uk = u[k].as_f64().unwrap();
-            println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
-            assert!(err.abs() <= 2.0 * uk, "{} {k}: {err:+.4} ± {uk:.4}", t.spec.id);
-        }
+        assert_values_within_2u(&t.spec.id, r, tt, f64::INFINITY);
     }
 }
 
@@ -624,13 +634,7 @@ fn a_test_suspect_only_for_loose_ratios_votes_on_contacts() {
     let (res, truth) = reduced_with_truth("penalty-one-sided-s6");
     for t in &res.tests {
         let r = t.result.as_ref().unwrap();
-        println!(
-            "{} [{}] response {}, contact phases {}",
-            t.spec.id,
-            r.analysis.quality.describe(),
-            r.analysis.response.source,
-            r.analysis.contact_phases
-        );
+        print_reading(&t.spec.id, r);
         if r.analysis.quality.is_ok() {
             assert_ne!(r.analysis.response.source, "estimated", "{}", t.spec.id);
         }
@@ -643,14 +647,7 @@ fn a_test_suspect_only_for_loose_ratios_votes_on_contacts() {
         r.analysis.quality.describe()
     );
     let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == "E1_140_1").unwrap();
-    let c = serde_json::to_value(r.coefficients).unwrap();
-    let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
-    for k in KEYS {
-        let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
-        let uk = u[k].as_f64().unwrap();
-        println!("  {k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
-        assert!(err.abs() <= 0.01 && err.abs() <= 2.0 * uk, "{k}: {err:+.4} ± {uk:.4}");
-    }
+    assert_values_within_2u("E1_140_1", r, tt, 0.01);
 }
 
 /// A contact lead that collapsed carries the unresolved onset's term
@@ -678,15 +675,7 @@ fn a_collapsed_contact_lead_carries_the_unresolved_onset() {
         "{}",
         r.analysis.quality.describe()
     );
-    let tt = &truth["tests"][0];
-    let c = serde_json::to_value(r.coefficients).unwrap();
-    let u = serde_json::to_value(r.uncertainty.expect("u")).unwrap();
-    for k in KEYS {
-        let err = c[k].as_f64().unwrap() - tt[k].as_f64().unwrap();
-        let uk = u[k].as_f64().unwrap();
-        println!("{k} {:+.2} ± {:.2} pp", 100.0 * err, 100.0 * uk);
-        assert!(err.abs() <= 2.0 * uk, "{k}: {err:+.4} ± {uk:.4}");
-    }
+    assert_values_within_2u("E1_155_1", r, &truth["tests"][0], f64::INFINITY);
 }
 
 /// A local reading's shape term (the corner's reading against the smooth

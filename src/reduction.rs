@@ -171,21 +171,22 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
 }
 
 /// Contact phases are a property of the wall, not of one test: whether most of a
-/// campaign's tests show them (a strict majority of those with status ok, or
-/// suspect only for ratios read too loosely ([`votes`]), at least two). A test read through an estimated filter does not vote: its
-/// rounded impacts are what the filter and the contacts compete for, so it says
-/// nothing either way (on the penalty engine's one-sided campaign, seed 3, its
-/// vote kept 2 of 4 from a majority, and the 100 Hz test stayed ok through a
-/// filter the logger never had, r₁ 3.03 pp off: `tests/truth.rs`,
+/// campaign's tests show them (a strict majority of the tests that vote, at
+/// least two: status ok, or suspect only for ratios read too loosely,
+/// [`votes`]). A test read through an estimated filter does not vote: its
+/// rounded impacts are what the filter and the contacts compete for, so it
+/// says nothing either way (on the penalty engine's one-sided campaign, seed
+/// 3, its vote kept 2 of 4 from a majority, and the 100 Hz test stayed ok
+/// through a filter the logger never had, r₁ 3.03 pp off: `tests/truth.rs`,
 /// `a_test_read_through_an_estimated_filter_does_not_vote_on_contacts`).
-/// Returns (tests with contact phases, voting tests with status ok) when
-/// they do; a test of that campaign whose own log did not ask for contact phases
-/// is then re-analysed with [`crate::peaks::ContactModel::Expected`]
+/// Returns (tests with contact phases, tests that vote) when they do; a test
+/// of that campaign whose own log did not ask for contact phases is then
+/// re-analysed with [`crate::peaks::ContactModel::Expected`]
 /// (`rocklab::reduce::campaign_result`).
 pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> Option<(usize, usize)> {
-    let ok: Vec<&Analysis> = analyses.into_iter().filter(|a| votes(a) && a.response.source != "estimated").collect();
-    let with = ok.iter().filter(|a| a.contact_phases).count();
-    (ok.len() >= 2 && 2 * with > ok.len()).then_some((with, ok.len()))
+    let voters: Vec<&Analysis> = analyses.into_iter().filter(|a| votes(a) && a.response.source != "estimated").collect();
+    let with = voters.iter().filter(|a| a.contact_phases).count();
+    (voters.len() >= 2 && 2 * with > voters.len()).then_some((with, voters.len()))
 }
 
 /// Whether a test's analysis says what its wall's contacts are: status ok, or
@@ -200,7 +201,7 @@ pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analys
 fn votes(a: &Analysis) -> bool {
     match &a.quality {
         crate::peaks::Quality::Ok => true,
-        crate::peaks::Quality::Suspect(r) => r.iter().all(|w| crate::restitution::is_unresolved_reason(w)),
+        crate::peaks::Quality::Suspect(r) => !r.is_empty() && r.iter().all(|w| crate::restitution::is_unresolved_reason(w)),
     }
 }
 

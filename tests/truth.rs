@@ -17,9 +17,14 @@ const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", 
 /// state the logger's filter (the lab that does not know it: issue #18).
 /// The shipped fixture `name` reduced as its manifest says, and its truth.json.
 fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
+    reduced_with_options(name, PeakOptions::default())
+}
+
+/// As [`reduced_with_truth`], with the estimator's `options`.
+fn reduced_with_options(name: &str, options: PeakOptions) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
     let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-    (reduce_campaign(load_campaign(name, false), PeakOptions::default()), truth)
+    (reduce_campaign(load_campaign(name, false), options), truth)
 }
 
 /// The one-test fixture campaign `name` (a one-sided MuJoCo stand-in's test
@@ -661,14 +666,11 @@ fn a_test_suspect_only_for_loose_ratios_votes_on_contacts() {
 /// 1.7 u, r₁ −2.67 ± 1.55 pp).
 #[test]
 fn a_collapsed_contact_lead_carries_the_unresolved_onset() {
-    let name = "penalty-one-sided-100hz";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let options = PeakOptions {
         contacts: rocklab::peaks::ContactModel::Expected,
         ..PeakOptions::default()
     };
-    let res = reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), options);
+    let (res, truth) = reduced_with_options("penalty-one-sided-100hz", options);
     let r = res.tests[0].result.as_ref().unwrap();
     assert!(
         r.analysis.quality.is_ok() && r.analysis.contact_phases,

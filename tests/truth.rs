@@ -1088,6 +1088,46 @@ fn mujoco_holdouts_reduced_or_flagged() {
     assert!(h.2 && h.1 <= 1.0, "H1_140_2: ok {}, {:.2} pp off", h.2, h.1);
 }
 
+/// Issue 18's criterion on a wall the estimator was never tuned on, checked
+/// when it was made (twenty-ninth session): `tools/mujoco_campaign.py --preset
+/// fresh-two-sided --seed 2921` (H 3.40 m, b 0.30 m, a medium bedding of
+/// 4–12 ms, 100–1000 Hz). Measured: no test flagged, the ok tests within
+/// 0.71 pp, every peak within 2 of its stated u. Asserted: the issue's
+/// criterion (at most one test flagged, every ok value within 1.0 pp, ≥ 90 %
+/// of the ok tests' peaks within 2 u).
+#[test]
+fn a_fresh_two_sided_wall_meets_the_issue() {
+    let (flagged, worst, within) = holdout_summary("mujoco-fresh-two-sided");
+    assert!(flagged <= 1, "{flagged} tests flagged");
+    assert!(worst <= 1.0, "an ok test {worst:.2} pp off");
+    assert!(within >= 0.9, "{within:.2} of the peaks within 2 u");
+}
+
+/// Walls outside the range the one-sided reducer was tuned on, made when
+/// this was written (twenty-ninth session): `--preset fresh-one-sided --seed
+/// 2916` (a squat wall, H 1.90 m, b 0.32 m, on soft, very lossy transverse
+/// walls, κ 500–1500 s⁻², ζ 0.05–0.12: the push into them is as long as
+/// a free arc) and `--preset check-one-sided --seed 2904` (H 2.30 m,
+/// transverse walls 600–2500 s⁻²). The restraint arc and contact model do
+/// not describe them: measured, the soft wall's five tests all suspect (the
+/// fit misses the log, residuals around an impact, values 1.4–5.0 pp off)
+/// and the check wall's three of five (1.5–6.2 pp off), its two ok tests
+/// within 1.58 pp (r⁻ +1.58 ± 1.41) and 0.37 pp (docs/accuracy.md,
+/// "Twenty-ninth session"). Not the issue's criterion: what is asserted is
+/// that nothing is silently wrong: every ok test within 2.0 pp, and ≥ 90 % of
+/// their peaks within 2 of their stated u (measured: 100 %).
+#[test]
+fn walls_outside_the_tuned_range_are_flagged_or_within_their_u() {
+    for name in ["mujoco-soft-restraint-one-sided", "mujoco-check-one-sided"] {
+        let rep = holdout_report(name);
+        let (_, worst, within) = summary_of(name, &rep);
+        assert!(worst <= 2.0, "{name}: an ok test {worst:.2} pp off");
+        // With no ok test there is no peak to cover.
+        let any_ok = rep.iter().any(|t| t.2);
+        assert!(!any_ok || within >= 0.9, "{name}: {within:.2} of the ok tests' peaks within 2 u");
+    }
+}
+
 /// A one-sided test whose residuals stand out around exit impacts only
 /// (`peaks::exits_only_misfit`): the hold-out's H1_140_1, around impact 5 at
 /// 12.4 σ. Until the twentieth session it was suspect for them; its values

@@ -981,3 +981,25 @@ fn a_campaign_folder_stands_for_its_manifest() {
     );
     assert!(!tmp.path().join("c").exists());
 }
+
+/// A campaign with no test in the means says so at its head, on the terminal and
+/// in report.html: here the lab excludes its one test (`exclude_from_mean`), so no
+/// reason is named; the commonest suspect reason is unit-tested in
+/// `report::quality`.
+#[test]
+fn a_campaign_with_no_test_in_the_means_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("good.csv"), good_log()).unwrap();
+    let toml = format!("{HEAD}\n[[test]]\nid = \"good\"\nfile = \"good.csv\"\nexclude_from_mean = true\n");
+    let manifest = dir.path().join("campaign.toml");
+    std::fs::write(&manifest, toml).unwrap();
+    let out = dir.path().join("out");
+    let run = reduce(&manifest, &out, &[]);
+    assert_eq!(run.code, 0, "stderr: {}", run.stderr);
+    let line =
+        "The campaign's one test is not in the means (it is suspect, excluded or not reduced): there is no campaign mean and no restitution law.";
+    assert!(run.stderr.contains(line), "stderr: {}", run.stderr);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("class=\"none-vouched\""), "report.html lacks the sentence");
+    assert!(run.summary["mean"].is_null());
+}

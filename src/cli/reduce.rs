@@ -76,6 +76,9 @@ pub fn print_reduction(res: &CampaignResult) {
             ));
         }
     }
+    if let Some(none) = report::quality::none_vouched_in(res) {
+        super::tell(&none);
+    }
     let failed: Vec<_> = res.failed().collect();
     if !failed.is_empty() {
         super::tell(&format!("{} of {} tests failed:", failed.len(), res.tests.len()));

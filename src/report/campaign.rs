@@ -167,6 +167,12 @@ fn reduce_page(res: &CampaignResult, tabs: &[Table], figs: &TestFigures, extra: 
         res.options.method.describe()
     ));
     page.h2("Tables");
+    if let Some(none) = super::quality::none_vouched_in(res) {
+        page.raw(&format!(
+            "<p class=\"none-vouched\"><strong>{}</strong> See Quality below.</p>\n",
+            escape(&none)
+        ));
+    }
     if !res.means.left_out.is_empty() {
         page.p(&format!("Means leave out: {}.", res.means.left_out_text()));
     }

@@ -1106,8 +1106,8 @@ fn a_fresh_two_sided_wall_meets_the_issue() {
 /// Walls outside the range the one-sided reducer was tuned on, made when
 /// this was written (twenty-ninth session): `--preset fresh-one-sided --seed
 /// 2916` (a squat wall, H 1.90 m, b 0.32 m, on soft, very lossy transverse
-/// walls, κ 500–1500 s⁻², ζ 0.05–0.12: the push into them is as long as
-/// a free arc) and `--preset check-one-sided --seed 2904` (H 2.30 m,
+/// walls, κ 500–1500 s⁻², ζ 0.05–0.12: the push into them is nearly half
+/// as deep as the free arc after it) and `--preset check-one-sided --seed 2904` (H 2.30 m,
 /// transverse walls 600–2500 s⁻²). The restraint arc and contact model do
 /// not describe them: measured, the soft wall's five tests all suspect (the
 /// fit misses the log, residuals around an impact, values 1.4–5.0 pp off)

@@ -144,6 +144,10 @@ struct EveryImpact {
     /// ([`rocklab::impacts::local_impacts`]): listed, and (test, k, error, u).
     flagged_listed: usize,
     flagged_local: Vec<(String, usize, f64, f64)>,
+    /// Issue 20's law criterion on the reported impacts: (side, amplitude
+    /// |θ|/α from the log, true r), and the campaign's law where it has one.
+    law_points: Vec<(rocklab::wall::Side, f64, f64)>,
+    law: Option<rocklab::restitution_law::RestitutionLaw>,
 }
 
 impl EveryImpact {
@@ -153,7 +157,35 @@ impl EveryImpact {
     fn rms(&self) -> f64 {
         (self.reported.iter().map(|e| e.2 * e.2).sum::<f64>() / self.reported.len().max(1) as f64).sqrt()
     }
+    /// RMS of the law read at each reported impact's amplitude against the
+    /// truth, and of the best constant pair (each side's mean true r; one
+    /// constant where the law is shared by both sides), as `tests/law.rs`
+    /// scores the public campaigns.
+    fn law_rms(&self) -> Option<(f64, f64)> {
+        use rocklab::wall::Side;
+        let law = self.law.as_ref()?;
+        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+        let err: Vec<f64> = self.law_points.iter().map(|(side, a, r)| law.r(*side, *a) - r).collect();
+        let shared = law.parameters.shared;
+        let mean = |s: Side| {
+            let v: Vec<f64> = self.law_points.iter().filter(|p| shared || p.0 == s).map(|p| p.2).collect();
+            v.iter().sum::<f64>() / v.len().max(1) as f64
+        };
+        let (ci, co) = (mean(Side::Inward), mean(Side::Outward));
+        let cst: Vec<f64> = self
+            .law_points
+            .iter()
+            .map(|(side, _, r)| if *side == Side::Inward { ci } else { co } - r)
+            .collect();
+        Some((rms(&err), rms(&cst)))
+    }
     fn print(&self, name: &str) {
+        if let Some((law, cst)) = self.law_rms() {
+            println!(
+                "{name}: the law at the {} reported impacts' amplitudes: RMS {law:.4} against the truth (best constant pair {cst:.4})",
+                self.law_points.len()
+            );
+        }
         let mut z: Vec<f64> = self.reported.iter().map(|x| x.2.abs() / x.3).collect();
         z.sort_by(f64::total_cmp);
         println!(
@@ -264,6 +296,8 @@ fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
         worst_ok_pp: 0.0,
         flagged_listed: 0,
         flagged_local: Vec::new(),
+        law_points: Vec::new(),
+        law: res.law.as_ref().ok().map(|l| l.law.clone()),
     };
     let (mut rocking, mut all) = (empty(), empty());
     for t in &res.tests {
@@ -300,8 +334,10 @@ fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
                 let entry = (t.spec.id.clone(), k, i.r - r_true, i.r_u.unwrap_or(f64::NAN));
                 if rocks {
                     rocking.reported.push(entry.clone());
+                    rocking.law_points.push((i.side, i.amplitude_over_alpha, r_true));
                 }
                 all.reported.push(entry);
+                all.law_points.push((i.side, i.amplitude_over_alpha, r_true));
             }
         }
     }

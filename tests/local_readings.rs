@@ -297,7 +297,7 @@ fn every_impact_in(dir: &std::path::Path) -> (EveryImpact, EveryImpact) {
         flagged_listed: 0,
         flagged_local: Vec::new(),
         law_points: Vec::new(),
-        law: res.law.as_ref().ok().map(|l| l.law.clone()),
+        law: res.law.as_ref().ok().map(|l| l.law),
     };
     let (mut rocking, mut all) = (empty(), empty());
     for t in &res.tests {

@@ -184,9 +184,15 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
 /// re-analysed with [`crate::peaks::ContactModel::Expected`]
 /// (`rocklab::reduce::campaign_result`).
 pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> Option<(usize, usize)> {
+    let (with, voters) = contact_votes(analyses);
+    (voters >= 2 && 2 * with > voters).then_some((with, voters))
+}
+
+/// (tests with contact phases, tests that vote) of [`campaign_shows_contacts`],
+/// majority or not.
+pub fn contact_votes<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> (usize, usize) {
     let voters: Vec<&Analysis> = analyses.into_iter().filter(|a| votes(a) && a.response.source != "estimated").collect();
-    let with = voters.iter().filter(|a| a.contact_phases).count();
-    (voters.len() >= 2 && 2 * with > voters.len()).then_some((with, voters.len()))
+    (voters.iter().filter(|a| a.contact_phases).count(), voters.len())
 }
 
 /// Whether a test's analysis says what its wall's contacts are: status ok, or

@@ -133,6 +133,26 @@ pub struct PeakOptions {
     pub contacts: ContactModel,
     /// The data logger's filter, as the manifest states it ([`acquisition`]).
     pub acquisition: acquisition::Acquisition,
+    /// Where the onset of contact lies for a peak read as an instantaneous
+    /// impact ([`uncertainty::add_unresolved_contact`]).
+    pub onset: Onset,
+}
+
+/// What is known of the contact's onset at a peak read as an instantaneous
+/// impact (the free arc's speed at the zero, the upper end of the rectangle
+/// of [`uncertainty::add_unresolved_contact`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Onset {
+    /// Nothing: the impact may be as sharp as the log shows it (an idealised
+    /// log's is exactly at the zero), the onset anywhere in the last sample
+    /// interval, u = |ÿ| Δt/√12.
+    #[default]
+    WithinSample,
+    /// Other tests of the campaign show contact phases that this log does not
+    /// resolve: the onset comes before the zero, and the reading at the
+    /// rectangle's upper end is off by a mean square of w²/3, u = |ÿ| Δt/√3
+    /// (as a rival model's reading is taken, [`uncertainty::add_model_spread`]).
+    ContactsElsewhere,
 }
 
 impl Default for PeakOptions {
@@ -142,6 +162,7 @@ impl Default for PeakOptions {
             method: Method::Segments,
             contacts: ContactModel::FromLog,
             acquisition: acquisition::Acquisition::Unknown,
+            onset: Onset::WithinSample,
         }
     }
 }
@@ -516,7 +537,14 @@ fn late_readings(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, n_pe
 /// 0.81 pp); a FIR's response is symmetric and a few samples long (no test of
 /// the unstated FIR draw trips it). The case the FIR branch was measured on:
 /// docs/accuracy.md, "A campaign logged at 100 Hz".
-fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, peaks: &[Peak], n_peaks: usize) -> Option<String> {
+fn free_arc_ends_disagree(
+    t: &[f64],
+    p: &Prepared,
+    phys: &Physics,
+    fit: &SegmentFit,
+    peaks: &[Peak],
+    (n_peaks, onset): (usize, Onset),
+) -> Option<String> {
     let estimated_fir = fit.estimated.as_ref().is_some_and(|(e, _)| e.kind == acquisition::Generic::Fir64);
     if phys.rocking != Rocking::OneSided || !(unfiltered_contacts(fit) || estimated_fir) {
         return None;
@@ -533,7 +561,7 @@ fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &Segment
     // (`uncertainty::add_unresolved_contact`): that term is the very run past
     // the extreme that this check tests for, and widening its tolerance by it
     // let the case it was made for (100 Hz, v₄ +9.6 %) pass.
-    let onset = uncertainty::unresolved_contact_variances(fit.model(), p.dt, peaks.len());
+    let onset = uncertainty::unresolved_contact_variances(fit.model(), p.dt, peaks.len(), onset);
     let u: Vec<f64> = peaks
         .iter()
         .zip(&onset)
@@ -705,7 +733,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     });
     let build_cov = |exits_misfit: bool| {
         fit_cov.clone().map(|mut c| {
-            uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt);
+            uncertainty::add_unresolved_contact(&mut c, fit.model(), p.dt, opts.onset);
             // The two models of the contacts: their spread is partly shared by
             // the peaks, and not at all where the model misses the log at exits
             // (`exits_only_misfit`).
@@ -806,7 +834,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         &late,
     );
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
-    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks));
+    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, (n_peaks, opts.onset)));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):
     // a peak read from the global fit that depends on parameters the log does
     // not determine, or a covariance that is not one.

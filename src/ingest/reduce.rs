@@ -276,10 +276,15 @@ fn onsets_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: Vec
 }
 
 /// The majority's rule of [`with_campaign_contacts`]: contact phases for the
-/// tests whose own log did not ask for them.
+/// tests whose own log did not ask for them, and at an impact where such a
+/// test's fit finds no lead, the onset of the wall's contacts
+/// ([`Onset::ContactsElsewhere`]; twenty-ninth session: the penalty engine's
+/// one-sided seed 7, the 100 Hz E1_155_1's free-arc ends +1.5 to +3.5 % at
+/// u 0.8–1.2 %, now within 2 u).
 fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: Vec<TestOutcome>, with: usize, n_ok: usize) -> Vec<TestOutcome> {
     let expected = PeakOptions {
         contacts: ContactModel::Expected,
+        onset: Onset::ContactsElsewhere,
         ..*options
     };
     for t in tests.iter_mut() {

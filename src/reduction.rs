@@ -185,7 +185,13 @@ pub fn resolve_impacts(red: &mut Reduced, phys: &Physics, e_housner: f64, alpha_
 /// (`rocklab::reduce::campaign_result`).
 pub fn campaign_shows_contacts<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> Option<(usize, usize)> {
     let (with, voters) = contact_votes(analyses);
-    (voters >= 2 && 2 * with > voters).then_some((with, voters))
+    shows_contacts(with, voters).then_some((with, voters))
+}
+
+/// The majority of [`campaign_shows_contacts`] from its counts: at least two
+/// voters, more than half of them with contact phases.
+pub fn shows_contacts(with: usize, voters: usize) -> bool {
+    voters >= 2 && 2 * with > voters
 }
 
 /// (tests with contact phases, tests that vote) of [`campaign_shows_contacts`],

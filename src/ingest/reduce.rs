@@ -232,11 +232,11 @@ fn with_campaign_contacts(campaign: &Campaign, options: &PeakOptions, tests: Vec
     if options.method != Method::Segments || options.contacts == ContactModel::Expected {
         return tests;
     }
-    let analyses = || tests.iter().filter_map(|t| t.result.as_ref().ok()).map(|r| &r.analysis);
-    let (with, n_ok) = crate::reduction::contact_votes(analyses());
-    let tests = match crate::reduction::campaign_shows_contacts(analyses()) {
-        Some((with, n_ok)) => contacts_of_the_wall(campaign, options, tests, with, n_ok),
-        None => tests,
+    let (with, n_ok) = crate::reduction::contact_votes(tests.iter().filter_map(|t| t.result.as_ref().ok()).map(|r| &r.analysis));
+    let tests = if crate::reduction::shows_contacts(with, n_ok) {
+        contacts_of_the_wall(campaign, options, tests, with, n_ok)
+    } else {
+        tests
     };
     if with == 0 || options.onset != Onset::WithinSample {
         return tests;

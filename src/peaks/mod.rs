@@ -537,14 +537,7 @@ fn late_readings(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, n_pe
 /// 0.81 pp); a FIR's response is symmetric and a few samples long (no test of
 /// the unstated FIR draw trips it). The case the FIR branch was measured on:
 /// docs/accuracy.md, "A campaign logged at 100 Hz".
-fn free_arc_ends_disagree(
-    t: &[f64],
-    p: &Prepared,
-    phys: &Physics,
-    fit: &SegmentFit,
-    peaks: &[Peak],
-    (n_peaks, onset): (usize, Onset),
-) -> Option<String> {
+fn free_arc_ends_disagree(t: &[f64], p: &Prepared, phys: &Physics, fit: &SegmentFit, peaks: &[Peak], n_peaks: usize, onset: Onset) -> Option<String> {
     let estimated_fir = fit.estimated.as_ref().is_some_and(|(e, _)| e.kind == acquisition::Generic::Fir64);
     if phys.rocking != Rocking::OneSided || !(unfiltered_contacts(fit) || estimated_fir) {
         return None;
@@ -834,7 +827,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         &late,
     );
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
-    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, (n_peaks, opts.onset)));
+    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks, opts.onset));
     // Where the uncertainties cannot be computed, none is stated (never u = 0):
     // a peak read from the global fit that depends on parameters the log does
     // not determine, or a covariance that is not one.

@@ -399,13 +399,37 @@ fn assert_per_impact_criterion(name: &str, e: &EveryImpact) {
 }
 
 /// Issue 20's per-impact criterion on the one-sided hold-out (see
-/// [`every_impact_against_the_engine_truth`]): not met since H1_140_1 is ok
-/// (97 % of the listed impacts at RMS 0.0166).
+/// [`every_impact_against_the_engine_truth`]): not met from the session that
+/// let H1_140_1 through (97 % of the listed impacts at RMS 0.0166) until the
+/// contact model's free arcs took the centre that fits them
+/// (`late::centre_of`, thirtieth session: 97 % at RMS 0.0109).
 #[test]
-#[ignore = "issue 20's per-impact RMS on the one-sided hold-out, not met: 0.0166"]
 fn every_impact_on_the_one_sided_holdout() {
     let name = "mujoco-holdout-one-sided";
-    assert_per_impact_criterion(name, &every_impact(name).0);
+    let (e, _) = every_impact(name);
+    e.print(name);
+    assert_per_impact_criterion(name, &e);
+}
+
+/// The impacts after the table on a one-sided wall of the second engine
+/// (`fixtures/campaigns/penalty-one-sided-s3`, `tools/penalty_campaign.py`,
+/// Hunt–Crossley bedding, a nonlinear restraint): with the global fit's centre
+/// in the contact model's free arcs (387–389 mm against the engine's
+/// 384–386) most tests' lists stopped at the table's impacts (27 of 45 listed,
+/// 60 %, on the campaign this fixture was copied from); with the centre the
+/// arcs fit (`late::centre_of`) they run on (34 of 45, 76 %, RMS 0.0116).
+/// Asserted: at least 70 % (between the two), at issue 20's RMS 0.015.
+#[test]
+fn the_late_impacts_of_a_second_engines_one_sided_wall_are_read() {
+    let name = "penalty-one-sided-s3";
+    let (e, _) = every_impact(name);
+    e.print(name);
+    assert!(
+        e.coverage() >= 0.7 && e.rms() <= 0.015,
+        "{name}: {:.2} of the listed impacts at RMS {:.4}",
+        e.coverage(),
+        e.rms()
+    );
 }
 
 /// Issue 20's per-impact criterion on a two-sided wall the estimator was never

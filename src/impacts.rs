@@ -992,12 +992,12 @@ mod tests {
             apex_mm: 5.0,
             reading: None,
         };
-        let pushes = [0.070, 0.071, 0.073, 0.0735, 0.080];
-        let peaks = |arc_stretch: [f64; 4]| {
+        // Pushes 1, 3 … 9 of the given lengths (s), free arcs 2 … 8 between them.
+        let sequence = |pushes: [f64; 5], arc_stretch: [f64; 4]| {
             let mut out = Vec::new();
             let mut t = 0.0;
-            for i in 0..5 {
-                let p = push(2 * i + 1, t, pushes[i]);
+            for (i, &length) in pushes.iter().enumerate() {
+                let p = push(2 * i + 1, t, length);
                 t = p.crossing_s;
                 out.push(p);
                 if i < 4 {
@@ -1008,6 +1008,7 @@ mod tests {
             }
             out
         };
+        let peaks = |arc_stretch: [f64; 4]| sequence([0.070, 0.071, 0.073, 0.0735, 0.080], arc_stretch);
         // Every free arc rigid: the push of half-cycle 9 (0.080 / 0.070 = 1.14)
         // keeps impact 8 and on out; half-cycle 7 (1.05) does not.
         let (k, why) = law_end(&peaks([1.0; 4]), arc, &geo).expect("a push that barely lifts off");
@@ -1027,22 +1028,7 @@ mod tests {
         // the last, which no free arc follows (half-cycle 9, 1.20 × the first);
         // the first one followed by a free arc longer than RIGID_ARC_RATIO
         // ends it (half-cycle 5, 1.11 ×, with the arc after it at 1.02).
-        let softening = |arc_stretch: [f64; 4]| {
-            let lengths = [0.070, 0.075, 0.078, 0.081, 0.084];
-            let mut out = Vec::new();
-            let mut t = 0.0;
-            for (i, &length) in lengths.iter().enumerate() {
-                let p = push(2 * i + 1, t, length);
-                t = p.crossing_s;
-                out.push(p);
-                if i < 4 {
-                    let a = arc_peak(2 * i + 2, t, 0.2 / (i + 1) as f64, arc_stretch[i]);
-                    t = a.crossing_s;
-                    out.push(a);
-                }
-            }
-            out
-        };
+        let softening = |arc_stretch: [f64; 4]| sequence([0.070, 0.075, 0.078, 0.081, 0.084], arc_stretch);
         let (k, why) = law_end(&softening([1.0, 1.005, 1.008, 1.0]), arc, &geo).expect("the last push");
         assert_eq!(k, 8, "{why}");
         let (k, why) = law_end(&softening([1.0, 1.005, 1.02, 1.0]), arc, &geo).expect("a free arc that lengthens after a long push");

@@ -625,9 +625,7 @@ impl<'a> FreeColumns<'a> {
             Chi2::NotFinite
         }
     }
-}
 
-impl FreeColumns<'_> {
     /// [r·r, r·r', r'·r'] of the residuals r of the fit `c` of these samples
     /// and r' of the fit `c1` of `other`'s (the same window and motion), with
     /// the contact's onset at τ_on ([`centre_quadratics`]).
@@ -1099,12 +1097,7 @@ pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma
             })
             .sum()
     };
-    let params = FreeMotion::Rocking {
-        rate: arc.0,
-        centre_mm: arc.1,
-    }
-    .free_count()
-        + 2;
+    let params = at_zero.free_count() + 2;
     let nu: f64 = windows.iter().map(|(tau, _)| tau.len().saturating_sub(params) as f64).sum();
     if score(arc.1) <= nu + 3.0 * (2.0 * nu).sqrt() {
         return arc.1;
@@ -1132,8 +1125,8 @@ pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma
 /// (the motion `m` with centre 0) to the samples and to a constant 1, since the
 /// fit is linear and the centre only shifts the samples (y − y_c). Two fits per
 /// onset serve every centre [`centre_of`] tries: fitting again at each of its
-/// 72 centres made a one-sided 2,000,000-row log take 3.4 s instead of 0.7
-/// (docs/speed.md). Onsets whose fit is singular are left out.
+/// 72 centres cost a one-sided 2,000,000-row log 0.3 s of CPU (2.07 against
+/// 1.76 s user, docs/speed.md). Onsets whose fit is singular are left out.
 fn centre_quadratics(tau: &[f64], y: &[f64], m: FreeMotion) -> Vec<[f64; 3]> {
     if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
         return Vec::new();

@@ -6,6 +6,39 @@
 
 use nalgebra::{DMatrix, DVector};
 
+/// Golden-section search for the minimum of `f` on [a, b], down to a bracket
+/// narrower than `tol`; returns the better of the bracket's two inner points
+/// (ties to the upper one). Used where a 1-D cost is unimodal on a bracket
+/// found by a grid (the free arcs' centre, `peaks::late::centre_of`) or a
+/// bounded interval (a logger's cut-off, `peaks::acquisition`).
+pub fn golden_section(mut a: f64, mut b: f64, tol: f64, f: &mut impl FnMut(f64) -> f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let mut fc = f(c);
+    let mut fd = f(d);
+    while b - a > tol {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    if fc < fd {
+        c
+    } else {
+        d
+    }
+}
+
 /// Why a fit stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

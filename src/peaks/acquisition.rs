@@ -646,7 +646,7 @@ pub fn rounding_trend(est: &Estimate, tw: &[f64], yw: &[f64], dt: f64, sigma: f6
         seen.push((x, cost));
         cost
     };
-    golden(a0, b0, 0.05, &mut eval);
+    crate::fit::golden_section(a0, b0, 0.05, &mut eval);
     let u = curvature_u(&seen, sigma2)?;
     Some(Trend {
         late_hz: best.0.exp(),
@@ -654,30 +654,6 @@ pub fn rounding_trend(est: &Estimate, tw: &[f64], yw: &[f64], dt: f64, sigma: f6
         u,
         gain: (est.fitted.fit.cost - best.1.fit.cost) / sigma2,
     })
-}
-
-/// Golden-section search for the minimum of `f` on [a, b] down to `tol`.
-fn golden(mut a: f64, mut b: f64, tol: f64, f: &mut impl FnMut(f64) -> f64) {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let mut fc = f(c);
-    let mut fd = f(d);
-    while b - a > tol {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
 }
 
 /// σ of the minimiser of a least-squares cost sampled at (x, cost): the

@@ -726,18 +726,26 @@ fn contact_fits(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigm
     contact_fits_every(tau, y, m, shape, sigma, 1)
 }
 
-/// [`contact_fits`] at every `stride`-th onset of its grid.
-fn contact_fits_every(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigma: f64, stride: usize) -> Vec<ContactFit> {
+/// The onsets τ_on of a window's contact fits, every `stride`-th of the grid
+/// every [`ONSET_STEP_S`] from the crossing back to two samples into the
+/// window; None where the window holds fewer than 2 × [`CONTACT_COLUMNS`]
+/// samples or starts after the crossing.
+fn onsets(tau: &[f64], stride: usize) -> Option<impl Iterator<Item = f64>> {
     if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
-        return Vec::new();
+        return None;
     }
     let first = tau[2.min(tau.len() - 1)].min(0.0);
     let steps = (-first / ONSET_STEP_S).floor() as usize;
+    Some((0..=steps).step_by(stride).map(|i| -(i as f64) * ONSET_STEP_S))
+}
+
+/// [`contact_fits`] at every `stride`-th onset of its grid.
+fn contact_fits_every(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigma: f64, stride: usize) -> Vec<ContactFit> {
+    let Some(grid) = onsets(tau, stride) else {
+        return Vec::new();
+    };
     let free = FreeColumns::new(tau, y, m);
-    (0..=steps)
-        .step_by(stride)
-        .filter_map(|i| free.fit(shape, -(i as f64) * ONSET_STEP_S, sigma))
-        .collect()
+    grid.filter_map(|tau_on| free.fit(shape, tau_on, sigma)).collect()
 }
 
 /// The velocity peak of half-cycle [start, zero] read with the contact model
@@ -986,16 +994,13 @@ enum Least {
 /// coefficients keep every residual finite, so that the fit would have counted.
 #[allow(clippy::too_many_arguments)]
 fn least_chi2(tau: &[f64], y: &[f64], m: FreeMotion, shape: ContactShape, sigma: f64, stride: usize, above: impl Fn(f64) -> bool) -> Least {
-    if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
+    let Some(grid) = onsets(tau, stride) else {
         return Least::NoFit;
-    }
-    let first = tau[2.min(tau.len() - 1)].min(0.0);
-    let steps = (-first / ONSET_STEP_S).floor() as usize;
+    };
     let free = FreeColumns::new(tau, y, m);
     let mut least: Option<f64> = None;
     let mut cut = false;
-    for i in (0..=steps).step_by(stride) {
-        let tau_on = -(i as f64) * ONSET_STEP_S;
+    for tau_on in grid {
         let Some((c, _)) = free.solve(shape, tau_on) else {
             continue;
         };
@@ -1080,7 +1085,7 @@ const CENTRE_RANGE: f64 = 0.05;
 /// where one window's free centre is nearly collinear with its cosh column.
 ///
 /// Search: a grid of 41 centres over the range, then golden-section in the
-/// two grid steps around the grid's least (30 steps).
+/// two grid steps around the grid's least, to 10⁻⁶ of that bracket.
 pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma: f64, arc: (f64, f64)) -> f64 {
     let windows: Vec<Window> = halves.iter().map(|&(a, b)| contact_window(t, y, a, b, post_s, ONE_SIDED_FROM)).collect();
     let at_zero = FreeMotion::Rocking { rate: arc.0, centre_mm: 0.0 };
@@ -1115,7 +1120,8 @@ pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma
     if best == 0 || best == GRID - 1 {
         return arc.1;
     }
-    golden_min(score, at(best - 1), at(best + 1), 30)
+    let (a, b) = (at(best - 1), at(best + 1));
+    crate::fit::golden_section(a, b, (b - a) * 1e-6, &mut |c| score(c))
 }
 
 /// For every onset of [`contact_fits`]'s grid in a window, the χ² of
@@ -1128,47 +1134,18 @@ pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma
 /// 72 centres cost a one-sided 2,000,000-row log 0.3 s of CPU (2.07 against
 /// 1.76 s user, docs/speed.md). Onsets whose fit is singular are left out.
 fn centre_quadratics(tau: &[f64], y: &[f64], m: FreeMotion) -> Vec<[f64; 3]> {
-    if tau.len() < 2 * CONTACT_COLUMNS || tau[0] >= 0.0 {
+    let Some(grid) = onsets(tau, 1) else {
         return Vec::new();
-    }
+    };
     let ones = vec![1.0; y.len()];
     let (fy, f1) = (FreeColumns::new(tau, y, m), FreeColumns::new(tau, &ones, m));
-    let first = tau[2.min(tau.len() - 1)].min(0.0);
-    let steps = (-first / ONSET_STEP_S).floor() as usize;
     let shape = ContactShape::Ramp;
-    (0..=steps)
-        .filter_map(|i| {
-            let tau_on = -(i as f64) * ONSET_STEP_S;
-            let (cy, _) = fy.solve(shape, tau_on)?;
-            let (c1, _) = f1.solve(shape, tau_on)?;
-            Some(fy.residual_products(&f1, shape, tau_on, &cy, &c1))
-        })
-        .collect()
-}
-
-/// The minimum of `f` on [a, b] by golden-section search (`steps` steps).
-fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, steps: usize) -> f64 {
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..steps {
-        if f1 <= f2 {
-            b = x2;
-            (x2, f2) = (x1, f1);
-            x1 = b - g * (b - a);
-            f1 = f(x1);
-        } else {
-            a = x1;
-            (x1, f1) = (x2, f2);
-            x2 = a + g * (b - a);
-            f2 = f(x2);
-        }
-    }
-    if f1 <= f2 {
-        x1
-    } else {
-        x2
-    }
+    grid.filter_map(|tau_on| {
+        let (cy, _) = fy.solve(shape, tau_on)?;
+        let (c1, _) = f1.solve(shape, tau_on)?;
+        Some(fy.residual_products(&f1, shape, tau_on, &cy, &c1))
+    })
+    .collect()
 }
 
 /// A peak of a one-sided log read with the contact model ([`contact_peaks`]).

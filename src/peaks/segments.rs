@@ -407,6 +407,20 @@ const RESTART_GAMMAS: [f64; 4] = [3.0, 6.0, 10.0, 15.0];
 /// logger filter's rivalry, so that a lower contact cost cannot displace an
 /// estimated filter (on the unstated-Bessel draw, run before it, it let a
 /// 100 Hz test through 2.04 pp off with status ok).
+///
+/// A restart whose table peaks read the wall gaining energy ([`gains_energy`])
+/// neither replaces the first fit nor widens its u: free rocking only loses
+/// speed at an impact. Thirty-first session: on the penalty engine's one-sided
+/// seed 1, E1_160_1 (500 Hz), a restart within the evidence read the pushes at
+/// 6581, 4712 and 3458 mm/s (the truth 552, 413, 294), and its spread put
+/// ± 600 % on them (r₁ ± 527 pp); without it ± 14–20 %. On the MuJoCo
+/// stand-in Q1-s1419's Q1_155_1 (100 Hz) the lowest restart read |v₂| and |v₄|
+/// 0.4 and 0.8 % above |v₁| and |v₃|; taken, the test was ok at 2.17 pp off;
+/// the first fit reads it within 0.94 pp (`tests/truth.rs`,
+/// `a_restart_that_gains_energy_is_no_reading`). Over the 63 engine
+/// campaigns at hand the ok tests' worst values otherwise move by at most
+/// 0.13 pp, and one flagged test (the penalty seed 5's E1_140_1) is ok at
+/// 0.38 pp (docs/accuracy.md, "Restarts that gain energy").
 fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted, Option<Vec<f64>>) {
     let mut fits = vec![f];
     for g in RESTART_GAMMAS {
@@ -416,7 +430,12 @@ fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted,
             fits.push(c);
         }
     }
+    let m = fits[0].model.m();
+    let peaks = |f: &Fitted| (0..m).map(|k| f.model.peak(k).1).collect::<Vec<f64>>();
+    // A restart whose peaks gain energy is no reading of free rocking.
+    let credible = |f: &Fitted| !gains_energy(f);
     let lowest = (0..fits.len())
+        .filter(|&i| i == 0 || credible(&fits[i]))
         .min_by(|&a, &b| fits[a].fit.cost.total_cmp(&fits[b].fit.cost))
         .unwrap_or(0);
     // Another minimum replaces the first fit only where the data prefer it by
@@ -427,18 +446,26 @@ fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted,
         0
     };
     let best = fits.swap_remove(chosen);
-    let m = best.model.m();
-    let peaks = |f: &Fitted| (0..m).map(|k| f.model.peak(k).1).collect::<Vec<f64>>();
     let mine = peaks(&best);
     let rival = fits
         .iter()
-        .filter(|f| f.fit.cost - best.fit.cost <= evidence)
+        .filter(|f| f.fit.cost - best.fit.cost <= evidence && credible(f))
         .map(peaks)
         .map(|p| (p.iter().zip(&mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
         .filter(|(d, _)| d.is_finite() && *d > 0.0)
         .max_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, p)| p);
     (best, rival)
+}
+
+/// Whether a fit reads the wall gaining energy: a peak of the table faster
+/// than the one before it (|v_{k+1}| > |v_k|, an impact with e > 1). The
+/// model's last peak, at the end of the fit's window, is not one of the
+/// table's.
+fn gains_energy(f: &Fitted) -> bool {
+    let m = f.model.m().saturating_sub(1).max(1);
+    let peaks: Vec<f64> = (0..m).map(|k| f.model.peak(k).1).collect();
+    peaks.windows(2).any(|w| w[1].abs() > w[0].abs())
 }
 
 /// Starting values from the geometry and the crossings.

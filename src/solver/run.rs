@@ -21,6 +21,10 @@ pub enum SolverError {
     Initial { theta: f64, omega: f64 },
     #[error("ground motion: time step dt = {dt} and start t0 = {t0}: expected dt > 0 and finite t0")]
     Ground { dt: f64, t0: f64 },
+    /// A ground acceleration that is not a finite number (a record scaled
+    /// past the largest float: 10^309.4, found by `tests/fuzz.rs`).
+    #[error("ground motion: acceleration {value} m/s² at sample {sample}: expected finite numbers (a scale out of the physical range?)")]
+    Acceleration { sample: usize, value: f64 },
     /// The integrator rejected [`MAX_REJECTIONS`] steps in a row (issue 22: a
     /// record scaled by 10³⁰⁰ or a tolerance of 10⁻³⁰⁸ used to retry for ever).
     #[error("the integrator did not converge at t = {t} s: {rejections} steps rejected in a row, the last of {h:e} s (a ground motion or a tolerance out of the physical range?)")]
@@ -216,6 +220,9 @@ pub fn simulate_at(
             dt: ground.dt,
             t0: ground.t0,
         });
+    }
+    if let Some((sample, &value)) = ground.acc.iter().enumerate().find(|(_, a)| !a.is_finite()) {
+        return Err(SolverError::Acceleration { sample, value });
     }
     let mut out = Outputs {
         times: outputs,

@@ -18,7 +18,10 @@
 //! through no logger filter (the contact model does not model one), with
 //! status ok and stated uncertainties, every odd peak of the table is replaced
 //! by its contact reading where every one of them fits the samples to the noise
-//! (χ² ≤ ν + 3√(2ν)); otherwise none is. All of one side or none: the tables
+//! (χ² ≤ ν + 3√(2ν)); otherwise none is, unless the global fit reads one of
+//! the pushes to worse than 5 % of its speed ([`LOOSE_PUSH`]: the test could
+//! not be vouched for with it), where a reading up to χ²/ν = 5 is taken too,
+//! its u scaled by √(χ²/ν) (thirty-first session). All of one side or none: the tables
 //! are ratios, which cancel a bias that the peaks of one side share only if one
 //! reading gives them all (as [`super::local`] keeps one method per test). A
 //! replacement that would make any ratio of consecutive peaks exceed 1 (a wall
@@ -102,7 +105,7 @@ pub fn read_inward_peaks(a: &mut Analysis, t: &[f64], lever_mm: f64) -> bool {
     }
     let Some(arc) = a.small_arc else { return false };
     let read = contact_peaks(a, t, lever_mm, arc, PEAKS_READ, CONTACT_POST_S);
-    let new = replacements(a, &read);
+    let new = choose(a, &read);
     a.contact_readings = Some(read);
     let Some(new) = new else { return false };
     apply(a, &new);
@@ -147,14 +150,58 @@ struct Replacement {
 /// unsettled ([`super::checks::zero_readings_disagree`]).
 const UNDETERMINED: f64 = 0.2;
 
+/// Where a push's contact reading misses the noise, the pushes are replaced
+/// only if the global fit reads one of them to no better than this fraction
+/// of its speed ([`pushes_loose`]): 5 %, about what leaves a ratio built on
+/// it beyond the ± 5 pp that a table value may carry
+/// (`crate::restitution`), so that the test could not be vouched for with
+/// the global readings.
+const LOOSE_PUSH: f64 = 0.05;
+
+/// The readings that fit the samples to the noise only (no χ²/ν limit above
+/// it), the rule's first try.
+const NOISE_ONLY: f64 = 0.0;
+
+/// The largest χ²/ν of a push's contact reading that the fallback takes
+/// ([`pushes_loose`]), its u scaled by √(χ²/ν). Thirty-first session: over
+/// the 63 engine campaigns at hand the pushes' readings that miss the noise
+/// have χ²/ν 1.5–4.7 and read −3.0 … +0.2 % of the truth (mean −1.4 %, 29
+/// readings), as close as those that fit (RMS 1.3 % against 1.4 % on the
+/// MuJoCo stand-ins, 1.3 against 0.9 % on the penalty engine).
+const MISFIT_LIMIT: f64 = 5.0;
+
+/// Whether the global fit reads some push (k odd) to worse than
+/// [`LOOSE_PUSH`] of its speed: there the contact readings are taken even
+/// where one of them misses the noise (up to [`MISFIT_LIMIT`]). Where the
+/// global fit reads every push well, a misfit reading is not taken: on the
+/// penalty engine's precise tests (global u 0.3–1 %) the first push's
+/// misfit readings were 1–2.6 % low, and replacing them moved r₁ from
+/// 0.61 to 2.15 pp off (pen1-s2's E1_170_1).
+fn pushes_loose(a: &Analysis) -> bool {
+    a.peaks
+        .iter()
+        .skip(1)
+        .step_by(2)
+        .any(|p| p.velocity_u_mm_s.is_none_or(|u| u > LOOSE_PUSH * p.velocity_mm_s.abs()))
+}
+
+/// The replacements: every push's reading at the noise, or, where the global
+/// fit reads a push loosely ([`pushes_loose`]), up to [`MISFIT_LIMIT`].
+/// The fallback is kept only where it reads every push to [`LOOSE_PUSH`] or
+/// better: what the global fit could not.
+fn choose(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> {
+    let tight = |new: &Vec<Replacement>| new.iter().all(|r| r.u_mm_s <= LOOSE_PUSH * r.velocity_mm_s.abs());
+    replacements(a, read, NOISE_ONLY).or_else(|| pushes_loose(a).then(|| replacements(a, read, MISFIT_LIMIT)).flatten().filter(tight))
+}
+
 /// The replacements of every odd peak, or None where one of them has no
 /// contact reading at the noise or the new peaks would gain energy.
-fn replacements(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> {
+fn replacements(a: &Analysis, read: &[ContactPeak], misfit_limit: f64) -> Option<Vec<Replacement>> {
     let n = a.peaks.len();
     let new = (1..n)
         .step_by(2)
         .map(|k| {
-            let c = read.iter().find(|q| q.k == k)?.reading.filter(|c| c.fits_noise())?;
+            let c = read.iter().find(|q| q.k == k)?.reading.and_then(|c| c.scaled_to_misfit(misfit_limit))?;
             let global = a.peaks[k];
             let same_sign = c.reading.velocity_mm_s * global.velocity_mm_s > 0.0;
             let d = global.velocity_mm_s - c.reading.velocity_mm_s;
@@ -321,7 +368,7 @@ mod tests {
         let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
         let mut a = analysis(&v, 5.0);
         let read = [reading(1, 408.0, 1.0, 50.0), reading(3, 303.0, 1.0, 50.0), reading(5, 224.0, 1.0, 50.0)];
-        let new = replacements(&a, &read).expect("replaced");
+        let new = replacements(&a, &read, NOISE_ONLY).expect("replaced");
         apply(&mut a, &new);
         let got: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
         assert_eq!(got, [-500.0, 408.0, -350.0, 303.0, -260.0, 224.0]);
@@ -354,7 +401,7 @@ mod tests {
     /// the samples to the noise.
     fn replace_at_the_noise(a: &mut Analysis, speeds: [f64; 3]) {
         let read: Vec<ContactPeak> = [1, 3, 5].iter().zip(speeds).map(|(&k, v)| reading(k, v, 1.0, 50.0)).collect();
-        let new = replacements(a, &read).expect("replaced");
+        let new = replacements(a, &read, NOISE_ONLY).expect("replaced");
         apply(a, &new);
     }
 
@@ -413,7 +460,7 @@ mod tests {
         b.peaks[3].velocity_u_mm_s = Some(4916f64.sqrt());
         b.peak_covariance.as_mut().unwrap()[3][3] = 4916.0;
         let far = [reading(1, 408.0, 1.0, 50.0), reading(3, 220.0, 1.0, 50.0), reading(5, 178.0, 1.0, 50.0)];
-        let new = replacements(&b, &far).expect("replaced");
+        let new = replacements(&b, &far, NOISE_ONLY).expect("replaced");
         let r3 = new.iter().find(|r| r.k == 3).unwrap();
         // u² = 1 + 2.2² + (80² − 4900).
         assert!((r3.u_mm_s - (1.0 + 4.84 + 1500.0f64).sqrt()).abs() < 1e-9, "{}", r3.u_mm_s);
@@ -427,13 +474,46 @@ mod tests {
         let mut a = analysis(&v, 5.0);
         a.peaks[1].velocity_u_mm_s = Some(0.0);
         let read = [reading(1, 400.0, 2.0, 50.0), reading(3, 300.0, 1.0, 50.0), reading(5, 220.0, 1.0, 50.0)];
-        let new = replacements(&a, &read).expect("replaced");
+        let new = replacements(&a, &read, NOISE_ONLY).expect("replaced");
         apply(&mut a, &new);
         let cov = a.peak_covariance.as_ref().unwrap();
         assert_eq!(a.peaks[1].velocity_u_mm_s, Some(2.0));
         assert_eq!(cov[1][1], 4.0);
         assert!((0..6).filter(|&j| j != 1).all(|j| cov[1][j] == 0.0 && cov[j][1] == 0.0));
         assert!(cov.iter().flatten().all(|x| x.is_finite()));
+    }
+
+    /// A push whose reading misses the noise (χ²/ν = 3): nothing is replaced
+    /// where the global fit reads every push to 5 % or better; where it reads
+    /// one to worse, every push is replaced, the misfit reading's u scaled by
+    /// √3; beyond χ²/ν = 5, or where a replaced push would still be read to
+    /// worse than 5 %, nothing is.
+    #[test]
+    fn a_misfit_push_is_taken_only_where_the_global_fit_reads_a_push_loosely() {
+        let read = |chi2: f64| [reading(1, 398.0, 1.0, chi2), reading(3, 303.0, 1.0, 50.0), reading(5, 224.0, 1.0, 50.0)];
+        // Peak 3's own part 1 (u 4.1, 1.4 %): every push read well.
+        let mut precise = with_own_part(1.0);
+        assert!(!read_inward(&mut precise, &read(165.0)));
+        // Own part 400 (u √416, 6.8 %): loose.
+        let mut loose = with_own_part(400.0);
+        assert!(read_inward(&mut loose, &read(165.0)));
+        assert_eq!(loose.peaks[1].velocity_mm_s, 398.0);
+        // Peak 1: swapped u² = 25 − 9 + 3 (the reading's 1 scaled by √3)
+        // beats √(3 + 2²).
+        assert!((loose.peaks[1].velocity_u_mm_s.unwrap() - 19f64.sqrt()).abs() < 1e-12);
+        assert_eq!(loose.peaks[3].velocity_mm_s, 303.0);
+        let mut far = with_own_part(400.0);
+        assert!(!read_inward(&mut far, &read(330.0)));
+        // A reading that leaves a push loose (peak 5's ± 12, 5.4 %) is not taken.
+        let mut wide = with_own_part(400.0);
+        let mut r = read(165.0);
+        r[2] = reading(5, 224.0, 12.0, 50.0);
+        assert!(!read_inward(&mut wide, &r));
+    }
+
+    /// [`choose`] on given readings, applied: whether the pushes were replaced.
+    fn read_inward(a: &mut Analysis, read: &[ContactPeak]) -> bool {
+        choose(a, read).map(|n| apply(a, &n)).is_some()
     }
 
     /// One odd peak not at the noise, a wall gaining energy, or a filter in
@@ -443,11 +523,11 @@ mod tests {
         let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
         let a = analysis(&v, 5.0);
         let misfit = [reading(1, 408.0, 1.0, 50.0), reading(3, 303.0, 1.0, 500.0), reading(5, 224.0, 1.0, 50.0)];
-        assert!(replacements(&a, &misfit).is_none());
+        assert!(replacements(&a, &misfit, NOISE_ONLY).is_none());
         let missing = [reading(1, 408.0, 1.0, 50.0), reading(5, 224.0, 1.0, 50.0)];
-        assert!(replacements(&a, &missing).is_none());
+        assert!(replacements(&a, &missing, NOISE_ONLY).is_none());
         let gains = [reading(1, 408.0, 1.0, 50.0), reading(3, 303.0, 1.0, 50.0), reading(5, 270.0, 1.0, 50.0)];
-        assert!(replacements(&a, &gains).is_none());
+        assert!(replacements(&a, &gains, NOISE_ONLY).is_none());
         let mut filtered = analysis(&v, 5.0);
         filtered.response.fir_cutoff_hz = Some(40.0);
         assert!(!eligible(&filtered));

@@ -396,6 +396,21 @@ impl ContactReading {
         let nu = self.n.saturating_sub(self.params) as f64;
         nu > 0.0 && self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
     }
+
+    /// The reading with its u scaled by √(χ²/ν) where it misses the noise
+    /// ([`Self::fits_noise`]), up to χ²/ν ≤ `limit`; as it is where it fits.
+    pub fn scaled_to_misfit(&self, limit: f64) -> Option<ContactReading> {
+        if self.fits_noise() {
+            return Some(*self);
+        }
+        let nu = self.n.saturating_sub(self.params) as f64;
+        let ratio = self.chi2 / nu;
+        (nu > 0.0 && ratio <= limit).then(|| {
+            let mut r = *self;
+            r.reading.u_mm_s *= ratio.sqrt();
+            r
+        })
+    }
 }
 
 /// The most columns of a contact fit: the free motion's and the contact's two.

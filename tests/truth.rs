@@ -1427,3 +1427,21 @@ fn a_restart_that_gains_energy_is_no_reading() {
     assert!(v.windows(2).all(|w| w[1] <= w[0]), "{v:?}");
     assert_values_within_2u("Q1_155_1", r, &truth["tests"][0], 0.01);
 }
+
+/// Where the global fit reads a push loosely (worse than 5 % of its speed),
+/// the pushes' contact readings are taken even where one of them misses the
+/// noise (`peaks::inward`, `MISFIT_LIMIT`). The penalty engine's one-sided
+/// seed 7, E1_140_1 (200 Hz): the global fit read peak 1 to ± 9.4 %, and the
+/// first push's contact reading fitted χ²/ν = 3.1 (the bound at its ν = 8 is
+/// 2.5 ν), so nothing was replaced and the test was suspect for r₁ ± 6.6 pp
+/// while every value was within 1.14 pp. Asserted: ok, the pushes read by
+/// the contact model, every table value within 2 of its u and within 2 pp
+/// (measured: r₁ −1.72 ± 3.37 pp, the rest within 0.56 pp).
+#[test]
+fn a_push_read_loosely_takes_the_contact_readings() {
+    let (res, truth) = reduced_with_truth("penalty-one-sided-loose-push");
+    let r = res.tests[0].result.as_ref().unwrap();
+    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
+    assert_eq!(r.analysis.contact_model_peaks(), [1, 3, 5]);
+    assert_values_within_2u("E1_140_1", r, &truth["tests"][0], 0.02);
+}

@@ -136,6 +136,9 @@ struct Replacement {
     /// The global fit does not read this push at all ([`UNDETERMINED`]): the
     /// peak's row and column are the contact reading's alone.
     independent: bool,
+    /// The contact reading's own u (mm/s; scaled by √(χ²/ν) where it misses
+    /// the noise).
+    reading_u_mm_s: f64,
 }
 
 /// A push whose global reading has an own standard uncertainty (from
@@ -187,10 +190,12 @@ fn pushes_loose(a: &Analysis) -> bool {
 
 /// The replacements: every push's reading at the noise, or, where the global
 /// fit reads a push loosely ([`pushes_loose`]), up to [`MISFIT_LIMIT`].
-/// The fallback is kept only where it reads every push to [`LOOSE_PUSH`] or
-/// better: what the global fit could not.
+/// The fallback is kept only where the contact model reads every push to
+/// [`LOOSE_PUSH`] or better (its own u): what the global fit could not. (On
+/// the compliant random draw's seed 1065, 100 Hz, the fifth push's reading
+/// was ± 6.5 % and 10.8 % off, and taken, the test was ok at 2.65 pp off.)
 fn choose(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> {
-    let tight = |new: &Vec<Replacement>| new.iter().all(|r| r.u_mm_s <= LOOSE_PUSH * r.velocity_mm_s.abs());
+    let tight = |new: &Vec<Replacement>| new.iter().all(|r| r.reading_u_mm_s <= LOOSE_PUSH * r.velocity_mm_s.abs());
     replacements(a, read, NOISE_ONLY).or_else(|| pushes_loose(a).then(|| replacements(a, read, MISFIT_LIMIT)).flatten().filter(tight))
 }
 
@@ -225,6 +230,7 @@ fn replacements(a: &Analysis, read: &[ContactPeak], misfit_limit: f64) -> Option
                 u_mm_s: u,
                 swapped_mm_s: swapped,
                 independent: undetermined.is_some(),
+                reading_u_mm_s: c.reading.u_mm_s,
             })
         })
         .collect::<Option<Vec<_>>>()?;
@@ -504,7 +510,7 @@ mod tests {
         assert_eq!(loose.peaks[3].velocity_mm_s, 303.0);
         let mut far = with_own_part(400.0);
         assert!(!read_inward(&mut far, &read(330.0)));
-        // A reading that leaves a push loose (peak 5's ± 12, 5.4 %) is not taken.
+        // A reading that reads a push loosely (peak 5's own ± 12, 5.4 %) is not taken.
         let mut wide = with_own_part(400.0);
         let mut r = read(165.0);
         r[2] = reading(5, 224.0, 12.0, 50.0);

@@ -21,7 +21,8 @@
 //! (χ² ≤ ν + 3√(2ν)); otherwise none is, unless the global fit reads one of
 //! the pushes to worse than 5 % of its speed ([`LOOSE_PUSH`]: the test could
 //! not be vouched for with it), where a reading up to χ²/ν = 5 is taken too,
-//! its u scaled by √(χ²/ν) (thirty-first session). All of one side or none: the tables
+//! its u scaled by √(χ²/ν), if every push's reading is then within 5 % of its
+//! speed (thirty-first session). All of one side or none: the tables
 //! are ratios, which cancel a bias that the peaks of one side share only if one
 //! reading gives them all (as [`super::local`] keeps one method per test). A
 //! replacement that would make any ratio of consecutive peaks exceed 1 (a wall
@@ -200,7 +201,9 @@ fn choose(a: &Analysis, read: &[ContactPeak]) -> Option<Vec<Replacement>> {
 }
 
 /// The replacements of every odd peak, or None where one of them has no
-/// contact reading at the noise or the new peaks would gain energy.
+/// contact reading at the noise (or, with `misfit_limit` above 0, none with
+/// χ²/ν up to it: [`super::late::ContactReading::scaled_to_misfit`]) or the new peaks
+/// would gain energy.
 fn replacements(a: &Analysis, read: &[ContactPeak], misfit_limit: f64) -> Option<Vec<Replacement>> {
     let n = a.peaks.len();
     let new = (1..n)

@@ -1169,6 +1169,23 @@ fn a_fresh_two_sided_wall_meets_the_issue() {
     assert_issue_18("mujoco-fresh-two-sided", holdout_summary("mujoco-fresh-two-sided"));
 }
 
+/// Two-sided contact phases that follow the impacts' speeds
+/// (`peaks::model::Model::speed_scale`, lead and lag ∝ (v̂₀/v̂_k)^½). The
+/// MuJoCo stand-in `--preset public-like-two-sided --seed 2502`: with one
+/// lead and one lag in time for every impact, its peaks read from −2.8 % (v₀)
+/// up to +10.1 % (v₅) on the 70 mm test (200 Hz), which was ok with r⁺
+/// +2.34 pp at a stated u of 1.37 pp, and the 90 mm test (200 Hz) was 0.77 pp
+/// off (thirty-second session). Asserted: issue 18's criterion, and every ok
+/// value within the issue's goal of 0.5 pp (measured: 0.17 pp; the 70 mm
+/// test is flagged, its late contact phases long beside their half-cycles).
+#[test]
+fn late_two_sided_contacts_follow_the_impacts_speeds() {
+    let name = "mujoco-two-sided-late-contacts";
+    let (flagged, worst, within) = holdout_summary(name);
+    assert_issue_18(name, (flagged, worst, within));
+    assert!(worst <= 0.5, "{name}: an ok test {worst:.2} pp off");
+}
+
 /// Issue 18's criterion on one campaign's (flagged, worst ok value in pp,
 /// share of the ok tests' peaks within 2 u): at most one test flagged, every
 /// ok value within 1.0 pp, ≥ 90 % of the peaks within 2 u.

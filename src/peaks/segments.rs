@@ -172,6 +172,11 @@ impl SegmentFit {
         if let Some((e, _)) = &estimated {
             (chosen, contacts, alternative) = (e.fitted.clone(), false, None);
         }
+        // Two-sided contact phases that follow the impacts' speeds
+        // ([`Model::speed_scale`]), where the data prefer them.
+        if !one_sided && contacts && estimated.is_none() && chosen.model.filter.is_none() {
+            chosen = contacts_by_speed(chosen, &tw, &yw, extra * n.ln() * sigma2);
+        }
         // One-sided contact fits start from an undamped restraint (γ = 0); a
         // restraint with its damping can sit in a second, lower minimum.
         let mut rival_minimum = None;
@@ -472,6 +477,34 @@ fn gains_energy(peaks: &[f64]) -> bool {
     table.windows(2).any(|w| w[1].abs() > w[0].abs())
 }
 
+/// A two-sided contact fit `f` against the same fit with contact phases that
+/// follow the impacts' speeds ([`Model::speed_scale`]), fitted from `f`: it
+/// replaces `f` where it lowers the cost by more than `evidence` (the contact
+/// model's Bayesian criterion, as for [`restart_damping`]: the same number of
+/// parameters, another model). Fitted also from the contact fits' own starts,
+/// it read the 15 two-sided engine campaigns alike (one campaign's worst ok
+/// value 0.19 pp instead of 0.35) at 1.5 × the time.
+///
+/// Its contact phases are not required to be short here: where the data
+/// prefer contacts that grow long as the wall slows, the checks on the chosen
+/// fit (`checks::contacts_too_long`) then flag the test, where the time leads'
+/// shorter contacts would have passed it with its late peaks read high (the
+/// MuJoCo stand-in q2-s2502's Q2_70_1: v₅ +10.1 %, r⁺ +2.34 pp at u 1.37 pp,
+/// status ok).
+///
+/// Not tried with a stated or estimated filter (the model then goes through
+/// it, and the daq campaigns and the filter draws were measured without it).
+/// Not one-sided: there the leads of the impacts entering the inward side
+/// scaled so (β = ½, the pushes' own left alone) met issue 18's criterion on
+/// as many MuJoCo stand-ins as before (20 of 25) but left one test ok at
+/// 2.17 pp off (h1-s2952), and at β = 1 (the twenty-sixth session's probe)
+/// they cost the criterion on 8 of 25 (docs/accuracy.md).
+fn contacts_by_speed(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> Fitted {
+    let mut m = f.model.clone();
+    m.contacts_by_speed = true;
+    fit_model(m, tw, yw, 100).filter(|s| f.fit.cost - s.fit.cost > evidence).unwrap_or(f)
+}
+
 /// Starting values from the geometry and the crossings.
 #[allow(clippy::too_many_arguments)]
 fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: bool, t_dep: f64, start_t: f64, dt: f64) -> Model {
@@ -505,6 +538,7 @@ fn starting_model(inp: &FitInput, tw: &[f64], yw: &[f64], m: usize, one_sided: b
         lever,
         q,
         filter: None,
+        contacts_by_speed: false,
     };
     // A stated filter delays every kink of the log by about its group delay:
     // the crossings are that late, and so would the model's times be once the

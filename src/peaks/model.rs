@@ -225,9 +225,9 @@ impl Model {
     /// set by the large early ones, starts the late contacts too late: on the
     /// two-sided MuJoCo walls the peaks read from −1.4 % (v₀) up to +1 … +3 %
     /// (v₅) on 200 Hz tests and +10 % on the 70 mm ones. β = ½
-    /// ([`CONTACT_SPEED_EXPONENT`]) was measured best of 0, ½, ¾ and 1
-    /// (docs/accuracy.md, "Two-sided contacts that follow the impacts'
-    /// speeds").
+    /// ([`CONTACT_SPEED_EXPONENT`]) was kept of 0, ½, ¾ and 1, measured
+    /// (docs/accuracy.md, "Thirty-second session: two-sided contacts that
+    /// follow the impacts' speeds").
     pub fn speed_scale(&self, k: usize) -> f64 {
         if !self.contacts_by_speed || k == 0 {
             return 1.0;

@@ -122,7 +122,7 @@ fn test_plots(id: &str, r: &Reduced, e_h: f64) -> Result<(Figure, Figure), Repor
     let mut vel = vec![Series::line("velocity (per sample)", plots::GREY, velocity)];
     if !fit_x.is_empty() {
         disp.push(Series::line("free-rocking fit", plots::RED, fit_x));
-        vel.push(Series::line("fit, one-sided at impacts", plots::BLUE, fit_v));
+        vel.push(Series::line("free-rocking fit", plots::BLUE, fit_v));
     }
     vel.push(Series::dots("peaks v_k", plots::RED, peaks));
     let motion = [

@@ -393,8 +393,13 @@ pub struct ContactReading {
 impl ContactReading {
     /// Whether the model fits the samples to the noise: χ² ≤ ν + 3√(2ν).
     pub fn fits_noise(&self) -> bool {
-        let nu = self.n.saturating_sub(self.params) as f64;
+        let nu = self.dof();
         nu > 0.0 && self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+    }
+
+    /// ν = n − params, the fit's degrees of freedom.
+    fn dof(&self) -> f64 {
+        self.n.saturating_sub(self.params) as f64
     }
 
     /// The reading with its u scaled by √(χ²/ν) where it misses the noise
@@ -403,7 +408,7 @@ impl ContactReading {
         if self.fits_noise() {
             return Some(*self);
         }
-        let nu = self.n.saturating_sub(self.params) as f64;
+        let nu = self.dof();
         let ratio = self.chi2 / nu;
         (nu > 0.0 && ratio <= limit).then(|| {
             let mut r = *self;

@@ -326,14 +326,27 @@ impl Model {
         true
     }
 
-    /// The piece owning t; None past the last impact's onset.
-    fn owner(&self, t: f64) -> Option<Piece> {
+    /// Every impact's contact phase, (onset, end), computed once for a batch
+    /// of evaluations (the last impact's end is its onset: no arc follows it).
+    fn bounds(&self) -> Vec<(f64, f64)> {
         let m = self.m();
-        for k in 0..m {
-            if t < self.onset(k) {
+        (0..m)
+            .map(|k| {
+                let on = self.onset(k);
+                (on, if k + 1 < m { self.release_from_contact(k) } else { on })
+            })
+            .collect()
+    }
+
+    /// The piece owning t ([`Model::bounds`] given); None past the last
+    /// impact's onset.
+    fn owner(bounds: &[(f64, f64)], t: f64) -> Option<Piece> {
+        let m = bounds.len();
+        for (k, &(on, end)) in bounds.iter().enumerate() {
+            if t < on {
                 return Some(Piece::Arc(k));
             }
-            if k + 1 < m && t < self.release_from_contact(k) {
+            if k + 1 < m && t < end {
                 return Some(Piece::Contact(k));
             }
         }
@@ -457,8 +470,8 @@ impl Model {
     /// The contact phase of impact k: quintic Hermite ([`quintic_hermite`])
     /// between arc k at its onset and arc k+1 at the end of the contact (the
     /// arcs' shapes given, [`Model::shapes`]).
-    fn contact_shaped(&self, k: usize, shapes: &[Shape], t: f64) -> (f64, f64) {
-        let (t0, t1, before, after) = (self.onset(k), self.release_from_contact(k), shapes[k], shapes[k + 1]);
+    fn contact_shaped(&self, k: usize, shapes: &[Shape], bounds: &[(f64, f64)], t: f64) -> (f64, f64) {
+        let ((t0, t1), before, after) = (bounds[k], shapes[k], shapes[k + 1]);
         let (y0, v0) = self.arc_shaped(k, before, t0);
         let (y1, v1) = self.arc_shaped(k + 1, after, t1);
         let (a0, a1) = (self.arc_accel(k, before, t0, (y0, v0)), self.arc_accel(k + 1, after, t1, (y1, v1)));
@@ -491,11 +504,11 @@ impl Model {
 
     /// [`Model::eval`] at many times, the arcs' A and p computed once.
     pub fn eval_many<'a>(&'a self, t: &'a [f64]) -> impl Iterator<Item = Option<(f64, f64)>> + 'a {
-        let shapes = self.shapes();
+        let (shapes, bounds) = (self.shapes(), self.bounds());
         t.iter().map(move |&ti| {
-            let (f, df) = match self.owner(ti)? {
+            let (f, df) = match Self::owner(&bounds, ti)? {
                 Piece::Arc(s) => self.arc_shaped(s, shapes[s], ti),
-                Piece::Contact(k) => self.contact_shaped(k, &shapes, ti),
+                Piece::Contact(k) => self.contact_shaped(k, &shapes, &bounds, ti),
             };
             Some((self.zero_line(ti) + f, df + self.q[ix::DRIFT]))
         })
@@ -568,11 +581,12 @@ impl Model {
     /// One reading of v_k: the extreme up to the model's zero, or, with
     /// `rest_line`, up to the later of the model's zero and the rest line.
     fn reading(&self, k: usize, shapes: &[Shape], rest_line: bool) -> (f64, f64) {
-        let v_end_t = self.onset(k);
+        let bounds = self.bounds();
+        let v_end_t = bounds[k].0;
         let v_end = self.arc_shaped(k, shapes[k], v_end_t).1;
-        let start = if k == 0 { self.release_time() } else { self.release_from_contact(k - 1) };
+        let start = if k == 0 { self.release_time() } else { bounds[k - 1].1 };
         let from = v_end_t - 0.25 * (v_end_t - start);
-        let to = if k + 1 < self.m() { self.release_from_contact(k) } else { v_end_t };
+        let to = bounds[k].1;
         let want = if k.is_multiple_of(2) { -1.0 } else { 1.0 };
         // Half-cycle k lies on the outward side for k even.
         let side = -want;
@@ -583,7 +597,7 @@ impl Model {
             // Arc k up to its end, then the contact phase (never arc k+1: its
             // start speed is the speed after the impact).
             let (y, v) = if t > v_end_t && k + 1 < self.m() {
-                self.contact_shaped(k, shapes, t)
+                self.contact_shaped(k, shapes, &bounds, t)
             } else {
                 self.arc_shaped(k, shapes[k], t)
             };

@@ -72,13 +72,29 @@ impl ImpactTable {
     pub fn first(&self, n: usize) -> ImpactTable {
         let keep: Vec<usize> = (0..self.impacts.len()).filter(|&i| self.impacts[i].k < n).collect();
         ImpactTable {
+            raw: self.raw.iter().take(keep.len() + 1).copied().collect(),
+            end: self.end.clone(),
+            ..self.subset(&keep)
+        }
+    }
+
+    /// The impacts after the first (k ≥ 1) with their covariance: the table without
+    /// the release's impact, whose r₁ the paper sets apart (Table 3).
+    pub fn after_release(&self) -> ImpactTable {
+        let keep: Vec<usize> = (0..self.impacts.len()).filter(|&i| self.impacts[i].k >= 1).collect();
+        self.subset(&keep)
+    }
+
+    /// The impacts at the indices `keep` and their covariance (no raw impacts, no end).
+    fn subset(&self, keep: &[usize]) -> ImpactTable {
+        ImpactTable {
             impacts: keep.iter().map(|&i| self.impacts[i]).collect(),
             r_cov: self
                 .r_cov
                 .as_ref()
                 .map(|c| keep.iter().map(|&i| keep.iter().map(|&j| c[i][j]).collect()).collect()),
-            raw: self.raw.iter().take(keep.len() + 1).copied().collect(),
-            end: self.end.clone(),
+            raw: Vec::new(),
+            end: None,
         }
     }
 }

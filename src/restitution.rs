@@ -137,11 +137,15 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
     if bad.is_empty() {
         return None;
     }
+    // Beyond 100 pp (or 100 % of a peak) the figure says only that the log does
+    // not determine it: "r₁ ± 330032.2 pp" read as a fault of the tool.
     let pp = |u: f64| {
-        if u.is_finite() {
-            format!("{:.1} pp", 100.0 * u)
-        } else {
+        if !u.is_finite() {
             "no finite u".into()
+        } else if u > 1.0 {
+            "more than 100 pp".into()
+        } else {
+            format!("{:.1} pp", 100.0 * u)
         }
     };
     let values: Vec<String> = bad.iter().map(|(s, u)| format!("{s} ± {}", pp(*u))).collect();
@@ -152,7 +156,12 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
         .take(6)
         .filter_map(|(k, (v, row))| {
             let rel = row.get(k).map(|c| c.max(0.0).sqrt() / v.abs())?;
-            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {:.0} %", 100.0 * rel))
+            let shown = if rel > 1.0 {
+                "more than 100".into()
+            } else {
+                format!("{:.0}", 100.0 * rel)
+            };
+            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {shown} %"))
         })
         .collect();
     let why = if peaks.is_empty() {
@@ -223,6 +232,14 @@ mod tests {
             "{why}"
         );
         assert!(!why.contains("peak"), "no peak is read loosely here: {why}");
+        // A u of thousands of pp, and a peak read to ± 500 %: not determined, said so.
+        a[6] = 33.0;
+        let mut loose = cov.clone();
+        loose[1][1] = 2000.0f64.powi(2);
+        let why = unresolved_reason(&Coefficients::from_array(a), &v, &loose).unwrap();
+        assert!(why.contains("r₁ ± more than 100 pp"), "{why}");
+        assert!(why.contains("peak 1 ± more than 100 %"), "{why}");
+        assert!(!why.contains("3300") && !why.contains("500 %"), "{why}");
         assert!(is_unresolved_reason(&why));
         assert!(!is_unresolved_reason("the fit misses the log: the residuals spread 0.1 mm"));
     }

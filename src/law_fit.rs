@@ -460,7 +460,7 @@ pub fn notes(sides: &[(String, SideFit)], kept: &[bool], level: f64, rise_after_
             // A kept form whose trend the test against a constant does not show.
             let unproven = if keeps && f.p_value >= level {
                 format!(
-                    "; the data do not reject a constant at the test's level (p = {:.2}), but the trend predicts them better (Akaike: F = {:.2} > {AIC_PENALTY})",
+                    "; the data do not reject a constant at the test's level (p = {:.3}), but the trend predicts them better (Akaike: F = {:.2} > {AIC_PENALTY})",
                     f.p_value, f.statistic
                 )
             } else {
@@ -488,19 +488,19 @@ pub fn notes(sides: &[(String, SideFit)], kept: &[bool], level: f64, rise_after_
                 .flatten();
             let why = if let (Some((c, stat)), true) = (released, f.statistic > AIC_PENALTY) {
                 format!(
-                    "the data favour a rise of r as the amplitude falls (F = {:.2}, p = {:.2}; r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}), but not without each test's first impact (the release's, whose r₁ the paper sets apart: c = {c:+.4}, F = {stat:.2}), and a rise the release's impacts alone carry is not taken for a law of amplitude",
+                    "the data favour a rise of r as the amplitude falls (F = {:.2}, p = {:.3}; r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}), but not without each test's first impact (the release's, whose r₁ the paper sets apart: c = {c:+.4}, F = {stat:.2}), and a rise the release's impacts alone carry is not taken for a law of amplitude",
                     f.statistic, f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
                 )
             } else if f.statistic <= AIC_PENALTY {
                 format!(
-                    "the data do not reject a constant (p = {:.2}): the speed-loss fit puts r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}, a trend the impacts' scatter cannot tell from none",
+                    "the data do not reject a constant (p = {:.3}): the speed-loss fit puts r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}, a trend the impacts' scatter cannot tell from none",
                     f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
                 )
             } else {
                 let shown = if f.p_value < level {
                     format!("the data reject a constant (p = {:.1e})", f.p_value)
                 } else {
-                    format!("the data favour a trend (F = {:.2}, p = {:.2})", f.statistic, f.p_value)
+                    format!("the data favour a trend (F = {:.2}, p = {:.3})", f.statistic, f.p_value)
                 };
                 format!(
                     "{shown} but the fitted speed loss is negative (r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}: rising as the amplitude falls), which the form does not describe",

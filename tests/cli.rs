@@ -287,6 +287,18 @@ fn demo_writes_tables_and_plots() {
             .filter(|t| t["peaks_read_by_contact_model"] == serde_json::json!([1, 3, 5]))
             .count();
         assert_eq!(inward, if c == "one-sided-demo" { 0 } else { 3 }, "{c}");
+        // The report says which rule picks the law's form; the engine campaign's
+        // inward rise is one the test does not show, and its note says so.
+        let html = std::fs::read_to_string(dir.path().join(c).join("report.html")).unwrap();
+        assert!(html.contains("where Akaike's criterion prefers it"), "{c}");
+        if c == "mujoco-public-one-sided" {
+            let note = fitted["notes"][0].as_str().unwrap();
+            assert!(note.starts_with("side in: speed-loss law") && note.contains("Akaike"), "{note}");
+            // Its form reads "r∞ (± u) + |c| (± u) / …", never "− -c".
+            let form = html.split("in: r(a) = ").nth(1).unwrap_or_default();
+            assert!(form.split(" / ").next().unwrap_or_default().contains(") + 0."), "{c}: the rise's sign");
+            assert!(!html.contains("− -"), "{c}");
+        }
         sets.push(law);
         if fitted["form"] != "constant" {
             sets.push(constant);

@@ -136,11 +136,13 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
     };
     let p = &fit.law.parameters;
     let side = |name: &str, l: &crate::restitution_law::SideLaw| {
+        // A rise (c < 0) reads "+ |c|", not "− -c".
         format!(
-            "{name}: r(a) = {:.4} (± {:.4}) − {:.5} (± {:.5}) / {}",
+            "{name}: r(a) = {:.4} (± {:.4}) {} {:.5} (± {:.5}) / {}",
             l.r_inf,
             l.cov[0][0].sqrt(),
-            l.c,
+            if l.c < 0.0 { "+" } else { "−" },
+            l.c.abs(),
             l.cov[1][1].sqrt(),
             match l.g {
                 crate::restitution_law::Shape::Free => "√(a(2 − a))",
@@ -187,9 +189,10 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         "The data do not reject a constant coefficient"
     };
     s.push_str(&format!(
-        "<p>{verdict} (level {} split over the sides): {}.</p>\n",
+        "<p>{verdict} (level {} split over the sides): {}. A side applies the speed-loss form where Akaike's criterion prefers it to the constant (F &gt; {}), which answers what r to predict rather than whether the data prove a trend; the notes say which side does and why.</p>\n",
         crate::law_fit::ALPHA_TEST,
-        escape(&tests.join("; "))
+        escape(&tests.join("; ")),
+        crate::law_fit::AIC_PENALTY
     ));
     s.push_str("<p>What the law vouches for:</p>\n<ul>\n");
     for n in &fit.notes {

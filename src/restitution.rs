@@ -156,12 +156,14 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
         .take(6)
         .filter_map(|(k, (v, row))| {
             let rel = row.get(k).map(|c| c.max(0.0).sqrt() / v.abs())?;
-            let shown = if rel > 1.0 {
-                "more than 100".into()
-            } else {
-                format!("{:.0}", 100.0 * rel)
+            let shown = |rel: f64| {
+                if rel > 1.0 {
+                    "more than 100".into()
+                } else {
+                    format!("{:.0}", 100.0 * rel)
+                }
             };
-            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {shown} %"))
+            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {} %", shown(rel)))
         })
         .collect();
     let why = if peaks.is_empty() {

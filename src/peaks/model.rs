@@ -558,13 +558,13 @@ impl Model {
     /// (and its time) is their mean, and [`Model::peak_spread`] their
     /// difference, a model-form term of its uncertainty (`uncertainty.rs`).
     pub fn peak(&self, k: usize) -> (f64, f64) {
-        let shapes = self.shapes();
-        let a = self.reading(k, &shapes, false);
+        let (shapes, bounds) = (self.shapes(), self.bounds());
+        let a = self.reading(k, &shapes, &bounds, false);
         if !self.layout.contacts {
             // Without contact phases both readings end at the arc's zero.
             return a;
         }
-        let b = self.reading(k, &shapes, true);
+        let b = self.reading(k, &shapes, &bounds, true);
         (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1))
     }
 
@@ -574,14 +574,13 @@ impl Model {
         if !self.layout.contacts {
             return 0.0;
         }
-        let shapes = self.shapes();
-        self.reading(k, &shapes, true).1 - self.reading(k, &shapes, false).1
+        let (shapes, bounds) = (self.shapes(), self.bounds());
+        self.reading(k, &shapes, &bounds, true).1 - self.reading(k, &shapes, &bounds, false).1
     }
 
     /// One reading of v_k: the extreme up to the model's zero, or, with
     /// `rest_line`, up to the later of the model's zero and the rest line.
-    fn reading(&self, k: usize, shapes: &[Shape], rest_line: bool) -> (f64, f64) {
-        let bounds = self.bounds();
+    fn reading(&self, k: usize, shapes: &[Shape], bounds: &[(f64, f64)], rest_line: bool) -> (f64, f64) {
         let v_end_t = bounds[k].0;
         let v_end = self.arc_shaped(k, shapes[k], v_end_t).1;
         let start = if k == 0 { self.release_time() } else { bounds[k - 1].1 };
@@ -597,7 +596,7 @@ impl Model {
             // Arc k up to its end, then the contact phase (never arc k+1: its
             // start speed is the speed after the impact).
             let (y, v) = if t > v_end_t && k + 1 < self.m() {
-                self.contact_shaped(k, shapes, &bounds, t)
+                self.contact_shaped(k, shapes, bounds, t)
             } else {
                 self.arc_shaped(k, shapes[k], t)
             };
@@ -1093,11 +1092,11 @@ mod tests {
         // The model's zero 3 mm below the rest line: the half-cycles on the
         // inward side (k odd) end later at the rest line than at the model's zero.
         m.q[ix::ZERO] = -3.0;
-        let shapes = m.shapes();
+        let (shapes, bounds) = (m.shapes(), m.bounds());
         let mut spread = 0.0;
         for k in 0..2 {
             let want = if k % 2 == 0 { -1.0 } else { 1.0 };
-            let (a, b) = (m.reading(k, &shapes, false), m.reading(k, &shapes, true));
+            let (a, b) = (m.reading(k, &shapes, &bounds, false), m.reading(k, &shapes, &bounds, true));
             let (t, v) = m.peak(k);
             assert!((v - 0.5 * (a.1 + b.1)).abs() < 1e-12 && (t - 0.5 * (a.0 + b.0)).abs() < 1e-12);
             assert!((m.peak_spread(k) - (b.1 - a.1)).abs() < 1e-12);

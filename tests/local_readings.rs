@@ -188,13 +188,15 @@ impl EveryImpact {
         }
         let mut z: Vec<f64> = self.reported.iter().map(|x| x.2.abs() / x.3).collect();
         z.sort_by(f64::total_cmp);
+        // With no impact reported (every test flagged) there is no RMS to print.
+        let accuracy = z.get(z.len() / 2).map_or("no RMS: none reported".to_string(), |m| {
+            format!("RMS {:.4}, median |err|/u {m:.2}", self.rms())
+        });
         println!(
-            "{name}: {} of {} listed impacts ({:.0} %), RMS {:.4}, median |err|/u {:.2}; {} tests flagged, ok tests within {:.2} pp",
+            "{name}: {} of {} listed impacts ({:.0} %), {accuracy}; {} tests flagged, ok tests within {:.2} pp",
             self.reported.len(),
             self.listed,
             100.0 * self.coverage(),
-            self.rms(),
-            z.get(z.len() / 2).copied().unwrap_or(f64::NAN),
             self.flagged,
             self.worst_ok_pp
         );
@@ -205,11 +207,13 @@ impl EveryImpact {
             let rms = (self.flagged_local.iter().map(|e| e.2 * e.2).sum::<f64>() / self.flagged_local.len().max(1) as f64).sqrt();
             let mut z: Vec<f64> = self.flagged_local.iter().map(|x| x.2.abs() / x.3).collect();
             z.sort_by(f64::total_cmp);
+            let accuracy = z
+                .get(z.len() / 2)
+                .map_or("no RMS: none read".to_string(), |m| format!("RMS {rms:.4}, median |err|/u {m:.2}"));
             println!(
-                "  flagged tests, the contact model alone: {} of their {} listed impacts, RMS {rms:.4}, median |err|/u {:.2}",
+                "  flagged tests, the contact model alone: {} of their {} listed impacts, {accuracy}",
                 self.flagged_local.len(),
                 self.flagged_listed,
-                z.get(z.len() / 2).copied().unwrap_or(f64::NAN)
             );
             for x in &self.flagged_local {
                 println!("    {} k{} {:+.4} (u {:.4})", x.0, x.1, x.2, x.3);

@@ -97,7 +97,7 @@ pub fn misfit(residuals: &[f64], sigma: f64) -> Option<String> {
 }
 
 /// 1.4826 × median |r|.
-fn robust_spread(r: &[f64]) -> f64 {
+pub fn robust_spread(r: &[f64]) -> f64 {
     if r.is_empty() {
         return 0.0;
     }

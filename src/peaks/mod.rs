@@ -281,6 +281,12 @@ pub struct Analysis {
     /// ([`late::contact_peaks`]), where [`inward`] read them; the per-impact
     /// table takes them from here instead of reading them again.
     pub contact_readings: Option<Vec<late::ContactPeak>>,
+    /// Per peak k of the global fit: how far its residuals within
+    /// ± [`LANDING_WINDOW_S`] of the peak stand out from the fit's own, RMS over
+    /// their robust spread over the whole fit (None where the window holds fewer
+    /// than 5 samples). [`inward`] reads a one-sided wall's late landings where it
+    /// is large.
+    pub local_misfit: Vec<Option<f64>>,
     /// Where the fit's model is known to miss the log without that being a
     /// reason (a one-sided wall's exits, [`exits_only_misfit`]), or the log
     /// leans towards contact phases that were not chosen
@@ -476,6 +482,31 @@ fn prepare_log(t: &[f64], x: &[f64], n_peaks: usize) -> Result<Prepared, PeakErr
     })
 }
 
+/// Half-width (s) of the window around a peak of the global fit whose residuals
+/// [`Analysis::local_misfit`] measures: 15 ms, about the time a MuJoCo bedding
+/// bears before θ = 0 at the late landings (docs/accuracy.md, "Thirty-fourth
+/// session"), and three samples a side at 200 Hz.
+pub const LANDING_WINDOW_S: f64 = 0.015;
+
+/// [`Analysis::local_misfit`]: per impact k < `n`, the RMS of the residuals
+/// (`resid` at the fitted window's times `tw`) within ± [`LANDING_WINDOW_S`] of
+/// its peak, over their robust spread over the whole fit.
+fn local_misfits(tw: &[f64], resid: &[f64], impacts: &[Impact], n: usize) -> Vec<Option<f64>> {
+    let spread = checks::robust_spread(resid);
+    impacts
+        .iter()
+        .take(n)
+        .map(|i| {
+            let (a, b) = (
+                tw.partition_point(|&t| t < i.time_s - LANDING_WINDOW_S),
+                tw.partition_point(|&t| t <= i.time_s + LANDING_WINDOW_S),
+            );
+            let r = resid.get(a..b.min(resid.len()))?;
+            (r.len() >= 5 && spread > 0.0).then(|| (r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64).sqrt() / spread)
+        })
+        .collect()
+}
+
 /// The classic estimator: a Savitzky–Golay derivative and its extreme in each
 /// half-cycle.
 fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis {
@@ -508,6 +539,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         },
         acquisition_note: None,
         contact_readings: None,
+        local_misfit: Vec::new(),
         model_note: None,
         deferred_reason: None,
     }
@@ -713,6 +745,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
     let resid = fit.residuals();
+    let local_misfit = local_misfits(&fit.tw, &resid, &impacts, n_peaks);
     let misfit = exits_only_misfit(&fit, &resid, phys, p.dt, p.sigma);
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());
@@ -866,6 +899,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             .clone()
             .or_else(|| fit.estimated.as_ref().and_then(|(e, _)| wide_rounding_note(e, p.dt))),
         contact_readings: None,
+        local_misfit,
         model_note: model_note.or_else(|| fit.leaning.as_ref().map(|_| LEANING_NOTE.to_string())),
         deferred_reason,
     })

@@ -189,6 +189,23 @@ fn too_few_peaks_is_reported_not_tabulated() {
     assert!(e.get("r").is_none(), "no table values for a failed test");
 }
 
+/// A late landing read by the contact model (`peaks::inward`, "Late landings":
+/// the hold-out's H1_140_1, peak 4) is listed in summary.json with the pushes and
+/// said on its own line of the report, not as a push into the transverse walls.
+#[test]
+fn a_late_landing_read_by_the_contact_model_is_said_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let run = reduce(&fixtures().join("mujoco-holdout-one-sided"), &out, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let e = test_entry(&run.summary, "H1_140_1");
+    assert_eq!(e["peaks_read_by_contact_model"], serde_json::json!([1, 3, 4, 5]));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("peaks 1, 3, 5: read by the contact model of the push"));
+    assert!(html.contains("peak 4: a late landing read by the contact model"));
+    assert!(!html.contains("peaks 1, 3, 4, 5"));
+}
+
 /// Format invariance: `;` with decimal comma, ms and m, and outward_sign = −1 with
 /// negated data give the same numbers. Tolerance 1e-6 on the ratios: the unit
 /// conversions change the inputs in the last bits (5 ms · 1e-3 ≠ 0.005 exactly), so

@@ -313,14 +313,24 @@ fn provenance(page: &mut Page, res: &CampaignResult, sources: &Sources) {
                 if let Some(note) = &r.analysis.model_note {
                     notes.push(vec![t.spec.id.clone(), format!("fit: {note}")]);
                 }
-                let inward = r.analysis.contact_model_peaks();
-                if !inward.is_empty() {
-                    let ks: Vec<String> = inward.iter().map(|k| k.to_string()).collect();
+                let (pushes, landings): (Vec<usize>, Vec<usize>) = r.analysis.contact_model_peaks().into_iter().partition(|k| k % 2 == 1);
+                let list = |ks: &[usize]| ks.iter().map(|k| k.to_string()).collect::<Vec<_>>().join(", ");
+                if !pushes.is_empty() {
                     notes.push(vec![
                         t.spec.id.clone(),
                         format!(
                             "peaks {}: read by the contact model of the push into the transverse walls, not the global fit (which reads them 1–5 % low on compliant walls; u the larger of the fit's and the two readings' difference)",
-                            ks.join(", ")
+                            list(&pushes)
+                        ),
+                    ]);
+                }
+                if !landings.is_empty() {
+                    notes.push(vec![
+                        t.spec.id.clone(),
+                        format!(
+                            "{} {}: a late landing read by the contact model, not the global fit, whose residuals stand out there (its one contact shape, set by the fast first landings, runs the free arc on too long and reads it fast; u the larger of the fit's and the two readings' difference)",
+                            if landings.len() == 1 { "peak" } else { "peaks" },
+                            list(&landings)
                         ),
                     ]);
                 }

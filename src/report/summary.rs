@@ -51,9 +51,10 @@ struct Reduction<'a> {
     /// contacts' rounding, why.
     #[serde(skip_serializing_if = "Option::is_none")]
     acquisition_note: Option<&'a str>,
-    /// One-sided walls: the peaks (k) read by the contact model of the push
-    /// into the transverse walls instead of the global fit
-    /// ([`crate::peaks::inward`]).
+    /// One-sided walls: the peaks (k) read by the contact model instead of the
+    /// global fit ([`crate::peaks::inward`]): the pushes into the transverse
+    /// walls (k odd) and the late landings whose fit's residuals stand out
+    /// (k even, from 4 on).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     peaks_read_by_contact_model: Vec<usize>,
     /// Where the fit's model misses the log without that being a reason (a

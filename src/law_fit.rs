@@ -824,6 +824,17 @@ mod tests {
         );
     }
 
+    /// The law of a one-sided campaign of the two tests `a` and `b`.
+    fn fit_two_one_sided(a: &ImpactTable, b: &ImpactTable) -> LawFit {
+        fit_law(Rocking::OneSided, &[TestImpacts { id: "a", table: a }, TestImpacts { id: "b", table: b }]).unwrap()
+    }
+
+    /// The inward side favours the form (Akaike) but does not reject the constant
+    /// at the level of a test of two sides.
+    fn weak(f: &LawFit) -> bool {
+        f.sides[0].1.statistic > AIC_PENALTY && f.sides[0].1.p_value > ALPHA_TEST / 2.0
+    }
+
     /// One-sided, inward: a rise that only the release's impacts carry (each test's
     /// first impact low, the paper's r₁) is not taken for a law of amplitude unless
     /// the test rejects the constant; a rise the data favour without them is.
@@ -847,18 +858,9 @@ mod tests {
             pts.extend(outward.iter().copied());
             table(&pts, 0.003)
         };
-        let fit_of = |rise: f64, first_low: f64| {
-            let (a, b) = (test(rise, first_low, false), test(rise, first_low, true));
-            fit_law(
-                Rocking::OneSided,
-                &[TestImpacts { id: "a", table: &a }, TestImpacts { id: "b", table: &b }],
-            )
-            .unwrap()
-        };
-        let level = ALPHA_TEST / 2.0;
-        let weak = |f: &LawFit| f.sides[0].1.statistic > AIC_PENALTY && f.sides[0].1.p_value > level;
+        let fit_of = |rise: f64, first_low: f64| fit_two_one_sided(&test(rise, first_low, false), &test(rise, first_low, true));
         // The first impacts alone low: the speed-loss fit rises, favoured but not shown.
-        let release = (1..100).map(|i| fit_of(0.0, 0.005 * i as f64)).find(|f| weak(f)).unwrap();
+        let release = (1..100).map(|i| fit_of(0.0, 0.005 * i as f64)).find(weak).unwrap();
         assert!(release.speed_loss.parameters.inward.c < 0.0, "{:?}", release.sides);
         assert_eq!(release.law.parameters.inward.c, 0.0, "{:?}", release.sides);
         assert!(
@@ -892,16 +894,7 @@ mod tests {
             pts.extend(outward.iter().copied());
             table(&pts, 0.003)
         };
-        let fit_of = |rise: f64| {
-            let (a, b) = (test(rise, false), test(rise, true));
-            fit_law(
-                Rocking::OneSided,
-                &[TestImpacts { id: "a", table: &a }, TestImpacts { id: "b", table: &b }],
-            )
-            .unwrap()
-        };
-        let level = ALPHA_TEST / 2.0;
-        let weak = |f: &LawFit| f.sides[0].1.statistic > AIC_PENALTY && f.sides[0].1.p_value > level;
+        let fit_of = |rise: f64| fit_two_one_sided(&test(rise, false), &test(rise, true));
         let fit = (1..400)
             .map(|i| fit_of(1e-3 * i as f64))
             .find(|f| weak(f) && f.speed_loss.parameters.inward.c < 0.0);

@@ -488,17 +488,15 @@ pub fn notes(sides: &[(String, SideFit)], kept: &[bool], level: f64, rise_after_
             // An inward rise the data favour but do not show (one-sided: the only
             // side named "in"), refused by the release check of `fit_law`.
             let unshown_rise = name == "in" && f.trend < 0.0 && f.p_value >= level && f.statistic > AIC_PENALTY;
-            let released = unshown_rise.then_some(rise_after_release).flatten();
-            let why = if unshown_rise && released.is_none() {
-                format!(
-                    "the data favour a rise of r as the amplitude falls (F = {:.2}, p = {:.3}; r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}), but without each test's first impact (the release's, whose r₁ the paper sets apart) too few inward impacts remain to show that the rise outlives it, and a rise the release's impacts alone may carry is not taken for a law of amplitude",
+            let why = if unshown_rise {
+                let favoured = format!(
+                    "the data favour a rise of r as the amplitude falls (F = {:.2}, p = {:.3}; r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3})",
                     f.statistic, f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
-                )
-            } else if let Some((c, stat)) = released {
-                format!(
-                    "the data favour a rise of r as the amplitude falls (F = {:.2}, p = {:.3}; r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}), but not without each test's first impact (the release's, whose r₁ the paper sets apart: c = {c:+.4}, F = {stat:.2}), and a rise the release's impacts alone carry is not taken for a law of amplitude",
-                    f.statistic, f.p_value, f.amplitude_min, -f.trend, f.trend_u, f.amplitude_max
-                )
+                );
+                match rise_after_release {
+                    None => format!("{favoured}, but without each test's first impact (the release's, whose r₁ the paper sets apart) too few inward impacts remain to show that the rise outlives it, and a rise the release's impacts alone may carry is not taken for a law of amplitude"),
+                    Some((c, stat)) => format!("{favoured}, but not without each test's first impact (the release's, whose r₁ the paper sets apart: c = {c:+.4}, F = {stat:.2}), and a rise the release's impacts alone carry is not taken for a law of amplitude"),
+                }
             } else if f.statistic <= AIC_PENALTY {
                 format!(
                     "the data do not reject a constant (p = {:.3}): the speed-loss fit puts r at a = {:.4} {:+.3} ± {:.3} from r at a = {:.3}, a trend the impacts' scatter cannot tell from none",

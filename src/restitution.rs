@@ -137,15 +137,11 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
     if bad.is_empty() {
         return None;
     }
-    // Beyond 100 pp (or 100 % of a peak) the figure says only that the log does
-    // not determine it: "r₁ ± 330032.2 pp" read as a fault of the tool.
     let pp = |u: f64| {
-        if !u.is_finite() {
-            "no finite u".into()
-        } else if u > 1.0 {
-            "more than 100 pp".into()
+        if u.is_finite() {
+            format!("{} pp", percent(u, 1))
         } else {
-            format!("{:.1} pp", 100.0 * u)
+            "no finite u".into()
         }
     };
     let values: Vec<String> = bad.iter().map(|(s, u)| format!("{s} ± {}", pp(*u))).collect();
@@ -156,14 +152,7 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
         .take(6)
         .filter_map(|(k, (v, row))| {
             let rel = row.get(k).map(|c| c.max(0.0).sqrt() / v.abs())?;
-            let shown = |rel: f64| {
-                if rel > 1.0 {
-                    "more than 100".into()
-                } else {
-                    format!("{:.0}", 100.0 * rel)
-                }
-            };
-            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {} %", shown(rel)))
+            (rel.is_nan() || rel > 2.0 * RATIO_U_MAX).then(|| format!("peak {k} ± {} %", percent(rel, 0)))
         })
         .collect();
     let why = if peaks.is_empty() {
@@ -176,6 +165,17 @@ pub fn unresolved_reason(u: &Coefficients, v: &[f64], cov: &[Vec<f64>]) -> Optio
         values.join(", "),
         100.0 * RATIO_U_MAX
     ))
+}
+
+/// A fraction as a percentage with `decimals`, or "more than 100" beyond 1: there
+/// the figure says only that the log does not determine it ("r₁ ± 330032.2 pp"
+/// read as a fault of the tool).
+fn percent(x: f64, decimals: usize) -> String {
+    if x > 1.0 {
+        "more than 100".into()
+    } else {
+        format!("{:.*}", decimals, 100.0 * x)
+    }
 }
 
 /// Standard uncertainty of every quantity, propagated to first order from the

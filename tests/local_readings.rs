@@ -150,6 +150,14 @@ struct EveryImpact {
     law: Option<rocklab::restitution_law::RestitutionLaw>,
 }
 
+/// "RMS …, median |err|/u …" of impacts (test, k, error, u); None where there are none.
+fn accuracy(impacts: &[(String, usize, f64, f64)]) -> Option<String> {
+    let mut z: Vec<f64> = impacts.iter().map(|x| x.2.abs() / x.3).collect();
+    z.sort_by(f64::total_cmp);
+    let rms = (impacts.iter().map(|e| e.2 * e.2).sum::<f64>() / impacts.len().max(1) as f64).sqrt();
+    z.get(z.len() / 2).map(|m| format!("RMS {rms:.4}, median |err|/u {m:.2}"))
+}
+
 impl EveryImpact {
     fn coverage(&self) -> f64 {
         self.reported.len() as f64 / self.listed.max(1) as f64
@@ -186,14 +194,10 @@ impl EveryImpact {
                 self.law_points.len()
             );
         }
-        let mut z: Vec<f64> = self.reported.iter().map(|x| x.2.abs() / x.3).collect();
-        z.sort_by(f64::total_cmp);
         // With no impact reported (every test flagged) there is no RMS to print.
-        let accuracy = z.get(z.len() / 2).map_or("no RMS: none reported".to_string(), |m| {
-            format!("RMS {:.4}, median |err|/u {m:.2}", self.rms())
-        });
+        let shown = accuracy(&self.reported).unwrap_or_else(|| "no RMS: none reported".into());
         println!(
-            "{name}: {} of {} listed impacts ({:.0} %), {accuracy}; {} tests flagged, ok tests within {:.2} pp",
+            "{name}: {} of {} listed impacts ({:.0} %), {shown}; {} tests flagged, ok tests within {:.2} pp",
             self.reported.len(),
             self.listed,
             100.0 * self.coverage(),
@@ -204,14 +208,9 @@ impl EveryImpact {
             println!("  {} k{} {:+.4} (u {:.4})", x.0, x.1, x.2, x.3);
         }
         if self.flagged > 0 {
-            let rms = (self.flagged_local.iter().map(|e| e.2 * e.2).sum::<f64>() / self.flagged_local.len().max(1) as f64).sqrt();
-            let mut z: Vec<f64> = self.flagged_local.iter().map(|x| x.2.abs() / x.3).collect();
-            z.sort_by(f64::total_cmp);
-            let accuracy = z
-                .get(z.len() / 2)
-                .map_or("no RMS: none read".to_string(), |m| format!("RMS {rms:.4}, median |err|/u {m:.2}"));
+            let shown = accuracy(&self.flagged_local).unwrap_or_else(|| "no RMS: none read".into());
             println!(
-                "  flagged tests, the contact model alone: {} of their {} listed impacts, {accuracy}",
+                "  flagged tests, the contact model alone: {} of their {} listed impacts, {shown}",
                 self.flagged_local.len(),
                 self.flagged_listed,
             );

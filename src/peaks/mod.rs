@@ -281,11 +281,11 @@ pub struct Analysis {
     /// ([`late::contact_peaks`]), where [`inward`] read them; the per-impact
     /// table takes them from here instead of reading them again.
     pub contact_readings: Option<Vec<late::ContactPeak>>,
-    /// Per peak k of the global fit: how far its residuals within
-    /// ± [`LANDING_WINDOW_S`] of the peak stand out from the fit's own, RMS over
-    /// their robust spread over the whole fit (None where the window holds fewer
-    /// than 5 samples). [`inward`] reads a one-sided wall's late landings where it
-    /// is large.
+    /// One-sided walls (empty otherwise), per peak k of the global fit: how far
+    /// its residuals within ± [`LANDING_WINDOW_S`] of the peak stand out from the
+    /// fit's own, RMS over their robust spread over the whole fit (None where the
+    /// window holds fewer than 5 samples). [`inward`] reads a late landing where
+    /// it is large.
     pub local_misfit: Vec<Option<f64>>,
     /// Where the fit's model is known to miss the log without that being a
     /// reason (a one-sided wall's exits, [`exits_only_misfit`]), or the log
@@ -745,7 +745,12 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // contact phases): a term of its uncertainty and a check.
     let spread: Vec<f64> = (0..n_peaks.min(fit.model().m())).map(|k| fit.model().peak_spread(k)).collect();
     let resid = fit.residuals();
-    let local_misfit = local_misfits(&fit.tw, &resid, &impacts, n_peaks);
+    // Read only by `inward`, on one-sided walls.
+    let local_misfit = if phys.rocking == Rocking::OneSided {
+        local_misfits(&fit.tw, &resid, &impacts, n_peaks)
+    } else {
+        Vec::new()
+    };
     let misfit = exits_only_misfit(&fit, &resid, phys, p.dt, p.sigma);
     let peak_cov = fit.fitted.peak_covariance(n_peaks, &fit.tw, &fit.yw);
     let undetermined = peak_cov.as_ref().map_or_else(Vec::new, |p| p.undetermined.clone());

@@ -448,6 +448,27 @@ fn every_impact_on_a_fresh_two_sided_wall() {
     assert_per_impact_criterion(name, &e);
 }
 
+/// A late two-sided impact is not read from two kinks where the contact model
+/// reads both its peaks near the noise (`impacts::LATE_MISFIT_LIMIT`):
+/// `fixtures/campaigns/mujoco-holdout-two-sided-s3504` (`--preset
+/// holdout-two-sided --seed 3504`, thirty-fifth session). Its 1000 Hz test
+/// H2_110_2 reported impact 5 from two kinks, 0.101 off the truth at u 0.029
+/// (3.5 u; the campaign's per-impact RMS 0.0234): peak 6's kink read the
+/// slope into its crossing, 9.1 ms past the peak. With the contact model's
+/// readings at χ²/ν 1.33 and 1.38 it is 0.006 off, and the campaign's RMS 0.0061.
+/// Asserted: every reported impact within 3 of its u, and issue 20's RMS.
+/// (Two of the campaign's five tests are flagged, so its coverage is 61 %.)
+#[test]
+#[cfg_attr(debug_assertions, ignore = "a campaign reduced; run in release")]
+fn late_two_sided_impacts_are_not_read_from_kinks_past_their_peaks() {
+    let name = "mujoco-holdout-two-sided-s3504";
+    let (e, _) = every_impact(name);
+    e.print(name);
+    let worst = e.reported.iter().map(|x| x.2.abs() / x.3).fold(0.0, f64::max);
+    assert!(worst <= 3.0, "{name}: an impact {worst:.1} u off");
+    assert!(e.rms() <= 0.015, "{name}: RMS {:.4}", e.rms());
+}
+
 /// Campaigns made by `tools/mujoco_campaign.py --preset fresh-*` (walls the
 /// estimator was never tuned on), in the directories listed in
 /// `FRESH_CAMPAIGNS` (separated by ':'): the per-impact figures and the

@@ -173,12 +173,28 @@ fn disagree_with(v: &[f64], u: &[f64], other: &[Option<(f64, f64)>], what: &str)
 /// each below a third of the shorter adjacent gravity arc (`spring[s]`: arc s is
 /// an inward arc of one-sided rocking, itself a contact with the transverse
 /// walls, which a contact phase may cover).
-pub fn contact_too_long(windows: &[(f64, f64)], arcs: &[f64], spring: &[bool]) -> Option<String> {
+///
+/// On a two-sided wall (no spring arc) the lag of an impact into an arc past
+/// the table's peaks (arc k + 1 ≥ `table`: the fit's closing arc, which ends
+/// the window after the table's last impact) is not checked: no value of the
+/// tables is read from that arc, and the impacts after the table's are read
+/// from the samples, not from the fit (`impacts::extend_late_two_sided`).
+/// There the speed-scaled contacts (`segments::contacts_by_speed`) are at
+/// their longest and the arc at its shortest. Thirty-fifth session: on four
+/// of the six campaigns made with the two-sided hold-out preset (seeds
+/// 3501–3506) and one public-like stand-in, tests flagged by that lag alone
+/// (50–85 ms beside arcs of 128–148 ms) read every value within 0.37–0.68 pp
+/// of the truth (docs/accuracy.md). One-sided walls keep the check: there the
+/// soft-restraint wall f1-s2918's F1_170_1, flagged by that lag alone
+/// (70.8 ms beside 167.4 ms), reads r₁⁺ 3.11 pp off.
+pub fn contact_too_long(windows: &[(f64, f64)], arcs: &[f64], spring: &[bool], table: usize) -> Option<String> {
+    let two_sided = !spring.iter().any(|&s| s);
     (0..arcs.len().saturating_sub(1)).find_map(|k| {
         let (lead, lag) = windows[k % windows.len()];
         let len = |s: usize| if spring[s] { f64::INFINITY } else { arcs[s] };
         let shorter = len(k).min(len(k + 1));
-        (lead.max(lag) > shorter / 3.0).then(|| {
+        let checked_lag = if two_sided && k + 1 >= table { 0.0 } else { lag };
+        (lead.max(checked_lag) > shorter / 3.0).then(|| {
             format!(
                 "the contact phase of impact {k} ({:.1} ms before, {:.1} ms after) is not short beside its half-cycles ({:.1} ms): the contact model does not describe this log",
                 1e3 * lead,
@@ -191,11 +207,11 @@ pub fn contact_too_long(windows: &[(f64, f64)], arcs: &[f64], spring: &[bool]) -
 
 /// [`contact_too_long`] for the contact windows `windows` of model
 /// `m`: its arcs' lengths, and which of them are inward arcs against the
-/// transverse walls (one-sided, s odd). Also the credibility of a rival
-/// contact fit (`segments::leaning_contacts`).
-pub fn contacts_too_long(m: &super::model::Model, windows: &[(f64, f64)]) -> Option<String> {
+/// transverse walls (one-sided, s odd); `table` peaks are read from the fit.
+/// Also the credibility of a rival contact fit (`segments::leaning_contacts`).
+pub fn contacts_too_long(m: &super::model::Model, windows: &[(f64, f64)], table: usize) -> Option<String> {
     let arcs: Vec<f64> = (0..m.m()).map(|s| m.arc_length(s)).collect();
-    contact_too_long(windows, &arcs, &inward_arcs(m))
+    contact_too_long(windows, &arcs, &inward_arcs(m), table)
 }
 
 /// Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
@@ -419,12 +435,27 @@ mod tests {
     #[test]
     fn long_contact_phases_trip() {
         let gravity = [false; 3];
-        assert!(contact_too_long(&[(0.005, 0.01), (0.005, 0.01)], &[0.5, 0.1, 0.4], &gravity).is_none());
-        assert!(contact_too_long(&[(0.005, 0.05), (0.005, 0.01)], &[0.5, 0.1, 0.4], &gravity)
+        let all = usize::MAX;
+        assert!(contact_too_long(&[(0.005, 0.01), (0.005, 0.01)], &[0.5, 0.1, 0.4], &gravity, all).is_none());
+        assert!(contact_too_long(&[(0.005, 0.05), (0.005, 0.01)], &[0.5, 0.1, 0.4], &gravity, all)
             .unwrap()
             .contains("impact 0"));
         // An inward arc of one-sided rocking may be covered.
-        assert!(contact_too_long(&[(0.005, 0.05), (0.005, 0.01)], &[0.5, 0.1, 0.4], &[false, true, false]).is_none());
+        assert!(contact_too_long(&[(0.005, 0.05), (0.005, 0.01)], &[0.5, 0.1, 0.4], &[false, true, false], all).is_none());
+    }
+
+    /// Two-sided: the lag into the fit's closing arc, past the table's peaks,
+    /// is not checked; its lead is, and so is a lag into an arc of the table,
+    /// and a one-sided wall's lag into its closing arc.
+    #[test]
+    fn a_two_sided_lag_past_the_tables_peaks_is_not_checked() {
+        let arcs = [0.5, 0.4, 0.3, 0.12];
+        let long_lag = [(0.01, 0.05)];
+        assert!(contact_too_long(&long_lag, &arcs, &[false; 4], 3).is_none());
+        assert!(contact_too_long(&long_lag, &arcs, &[false; 4], 4).unwrap().contains("impact 2"));
+        assert!(contact_too_long(&[(0.05, 0.01)], &arcs, &[false; 4], 3).unwrap().contains("impact 2"));
+        let one_sided = [false, true, false, false];
+        assert!(contact_too_long(&long_lag, &arcs, &one_sided, 3).unwrap().contains("impact 2"));
     }
 
     #[test]

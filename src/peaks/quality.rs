@@ -89,7 +89,7 @@ pub(super) fn plausibility(
                 .enumerate()
                 .map(|(k, &w)| if is_local(k) { (0.0, 0.0) } else { w })
                 .collect();
-            checks::contacts_too_long(m, &windows)
+            checks::contacts_too_long(m, &windows, v.len())
         }),
         if fit.contacts {
             checks::contact_overshoot(&v, &v_onset, &u, &overshoot_skip)

@@ -156,7 +156,7 @@ impl SegmentFit {
         // used: on the idealised draw that raised the median stated u of a
         // table value from 0.27 to 0.34 pp, against a median error of 0.02 pp.)
         let mut alternative = contacts.then(|| (0..m).map(|k| simple.model.peak(k).1).collect());
-        let leaning = probed.and_then(|c| leaning_contacts(&simple, &c, sigma2));
+        let leaning = probed.and_then(|c| leaning_contacts(&simple, &c, sigma2, inp.n_peaks));
         // No filter stated: a low-pass rounds the kinks too.
         let penalty = if contacts && !expected { extra * n.ln() } else { 0.0 };
         let rivals = super::acquisition::Rivals {
@@ -308,10 +308,12 @@ pub(crate) const LEANING_GAIN: f64 = 12.0;
 /// that gained 21.6 σ² and read peak 5 at 26 mm/s (the instantaneous fit: 95),
 /// and carried in u it left the test suspect for a u of ± 8 pp on r (it is
 /// 0.47 pp off).
-fn leaning_contacts(simple: &Fitted, c: &Fitted, sigma2: f64) -> Option<Vec<f64>> {
+fn leaning_contacts(simple: &Fitted, c: &Fitted, sigma2: f64, table: usize) -> Option<Vec<f64>> {
     let gain = (simple.fit.cost - c.fit.cost) / sigma2;
     let m = &c.model;
-    let short = m.contact_windows().is_none_or(|w| super::checks::contacts_too_long(m, &w).is_none());
+    let short = m
+        .contact_windows()
+        .is_none_or(|w| super::checks::contacts_too_long(m, &w, table).is_none());
     (gain > LEANING_GAIN && short).then(|| (0..c.model.m()).map(|k| c.model.peak(k).1).collect())
 }
 

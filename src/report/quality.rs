@@ -235,7 +235,10 @@ mod tests {
                 Kind::ImpactResiduals,
             ),
             (checks::disagreement(&[-100.0], &[0.1], &[Some((-50.0, 0.1))]), Kind::Disagreement),
-            (checks::contact_too_long(&[(0.05, 0.05)], &[0.1, 0.1], &[false, false]), Kind::LongContact),
+            (
+                checks::contact_too_long(&[(0.05, 0.05)], &[0.1, 0.1], &[false, false], usize::MAX),
+                Kind::LongContact,
+            ),
             (checks::contact_overshoot(&[-100.0], &[-50.0], &[0.1], &[false]), Kind::ContactOvershoot),
             (checks::zero_readings_disagree(&[-100.0], &[40.0]), Kind::ZeroReadings),
             (

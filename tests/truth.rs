@@ -1209,7 +1209,7 @@ fn late_two_sided_contacts_follow_the_impacts_speeds() {
 /// checked on two-sided walls (`peaks::checks::contact_too_long`). Asserted:
 /// issue 18's criterion (measured: H2_70_1 flagged, ok tests within 0.53 pp).
 #[test]
-fn a_two_sided_lag_past_the_tables_peaks_flags_nothing() {
+fn a_two_sided_lag_past_the_tables_peaks_is_no_reason_to_flag() {
     let name = "mujoco-holdout-two-sided-s3504";
     assert_issue_18(name, holdout_summary(name));
 }

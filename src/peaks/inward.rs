@@ -150,9 +150,10 @@ pub fn read_inward_peaks(a: &mut Analysis, t: &[f64], lever_mm: f64) -> bool {
     let read = contact_peaks(a, t, lever_mm, arc, PEAKS_READ, CONTACT_POST_S);
     let pushes = choose(a, &read);
     let mut all = pushes.clone().unwrap_or_default();
+    let n_pushes = all.len();
     all.extend(late_landings(a, &read));
     if gains_energy(a, &all) {
-        all = pushes.clone().unwrap_or_default();
+        all.truncate(n_pushes);
     }
     a.contact_readings = Some(read);
     // One application: the statistical parts are swapped once per entry.

@@ -361,9 +361,11 @@ fn residuals_at_an_exit_and_the_entry_after_it_do_not_flag_a_test_whose_peaks_do
 /// (e = 1.03, 1.08, 1.18 at impacts 1, 3, 5), and the last, which ends the
 /// tables' peak 5, is now checked as the others (e > 1 beyond 3 u): the test
 /// is suspect and says so. Reduced with its campaign, whose other tests show
-/// their contacts, it is read with contact phases and is ok, every value within
-/// 2 u of the truth (measured worst 1.04 pp, r⁺; 1.1 pp is the bound of
-/// `mujoco_at_100_hz_is_reduced_or_flagged`).
+/// their contacts, it is read with contact phases, every value within 2 u of
+/// the truth (measured worst 1.04 pp, r⁺; 1.1 pp is the bound of
+/// `mujoco_at_100_hz_is_reduced_or_flagged`); it was ok until the
+/// thirty-sixth session, and is suspect since only for its excursions into
+/// the transverse walls (5.2 samples, [`assert_suspect_only_for_short_inward_arcs`]).
 #[test]
 fn an_exit_that_gains_speed_at_the_last_table_peak_is_flagged() {
     use rocklab::report::quality::{kind, split, Kind};
@@ -390,7 +392,11 @@ fn an_exit_that_gains_speed_at_the_last_table_peak_is_flagged() {
     let res = load(name);
     for t in &res.tests {
         let r = t.result.as_ref().unwrap();
-        assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        if t.spec.id == "Q1_155_1" {
+            assert_suspect_only_for_short_inward_arcs("Q1_155_1", r);
+        } else {
+            assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        }
         assert!(r.analysis.contact_phases, "{}", t.spec.id);
         assert_values_within(r, &truth, &t.spec.id, BOUND_100HZ / 100.0);
     }
@@ -410,8 +416,11 @@ fn an_exit_that_gains_speed_at_the_last_table_peak_is_flagged() {
 /// estimated linear-phase FIR at 35.8 Hz (its contacts taken for a filter):
 /// its free arcs' ends +4.4 and +10.3 % against slopes of −5.8 and −4.7 %,
 /// r⁻ 1.68 pp off at u 0.45 pp until the check ran through an estimated
-/// FIR too; it is suspect for peak 4. The four others stay ok, within
-/// 1.4 u (0.84–1.22 pp).
+/// FIR too; it is suspect for peak 4. The four others were ok, within
+/// 1.4 u (0.84–1.22 pp); since the thirty-sixth session they are suspect
+/// for their excursions into the transverse walls alone (6–7 samples each,
+/// `checks::inward_arcs_unresolved`), where read with contact phases. Asserted
+/// too: their values within 2 u.
 #[test]
 fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
     use rocklab::peaks::analyse;
@@ -440,12 +449,15 @@ fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
             );
             continue;
         }
-        assert!(a.quality.is_ok(), "{}: {}", spec.id, a.quality.describe());
+        assert!(a.quality.is_ok_but_for_short_inward_arcs(), "{}: {}", spec.id, a.quality.describe());
+        assert_eq!(a.quality.is_ok(), !a.contact_phases, "{}: {}", spec.id, a.quality.describe());
         let v: Vec<f64> = a.peaks.iter().map(|p| p.velocity_mm_s).collect();
         let u = rocklab::restitution::uncertainties(&v, a.peak_covariance.as_ref().unwrap(), campaign.e_housner).unwrap();
         let u = serde_json::to_value(u).unwrap();
         for (k, err) in errors_pp(&v, campaign.e_housner, tt) {
-            println!("  {k}: {err:+.2} ± {:.2} pp", 100.0 * u[k].as_f64().unwrap());
+            let uk = 100.0 * u[k].as_f64().unwrap();
+            println!("  {k}: {err:+.2} ± {uk:.2} pp");
+            assert!(err.abs() <= 2.0 * uk, "{} {k}: {err:+.2} pp at u {uk:.2}", spec.id);
         }
     }
 }
@@ -670,9 +682,11 @@ fn a_test_suspect_only_for_loose_ratios_votes_on_contacts() {
 /// extrapolated speed at the zero past a truth peak at the contact's onset;
 /// with the onset anywhere in the last sample interval (u = |ÿ| Δt/√12) they
 /// carried ± 0.4–1.2 %, and 72 % of the campaign's ok peaks were within 2 u
-/// (twenty-ninth session). Asserted: both ok, without contact phases, with the
+/// (twenty-ninth session). Asserted: both without contact phases, with the
 /// rule's warning; each of their peaks within 2 of its stated u of the truth
-/// (measured: 100 %), and every table value within 2 u.
+/// (measured: 100 %), and every table value within 2 u; E1_140_1 ok, E1_155_1
+/// (ok until the thirty-sixth session) suspect only for its excursions into
+/// the transverse walls ([`assert_suspect_only_for_short_inward_arcs`]).
 #[test]
 fn instantaneous_readings_carry_the_onset_of_contacts_seen_elsewhere() {
     let (res, truth) = reduced_with_truth("penalty-one-sided-s11");
@@ -680,7 +694,12 @@ fn instantaneous_readings_carry_the_onset_of_contacts_seen_elsewhere() {
         let t = res.tests.iter().find(|t| t.spec.id == id).unwrap();
         let r = t.result.as_ref().unwrap();
         print_reading(id, r);
-        assert!(r.analysis.quality.is_ok() && !r.analysis.contact_phases, "{id}");
+        assert!(!r.analysis.contact_phases, "{id}");
+        if id == "E1_155_1" {
+            assert_suspect_only_for_short_inward_arcs(id, r);
+        } else {
+            assert!(r.analysis.quality.is_ok(), "{id}: {}", r.analysis.quality.describe());
+        }
         assert!(
             t.warnings.iter().any(|w| w.contains("the onset of a contact this log does not resolve")),
             "{id}: {:?}",
@@ -699,23 +718,31 @@ fn instantaneous_readings_carry_the_onset_of_contacts_seen_elsewhere() {
 /// phases from its campaign, and at its free arcs' ends the lead collapses;
 /// with the onset within a sample (/√12) those peaks read +1.5 to +3.5 % at
 /// u 0.8–1.2 %, and 92 % of the campaign's ok peaks were within 2 u
-/// (twenty-ninth session). Asserted: E1_155_1 ok with contact phases, each of
-/// its peaks within 2 of its stated u of the truth (measured: 100 %), every
-/// table value within 2 u.
+/// (twenty-ninth session). Asserted: E1_155_1 read with contact phases, each
+/// of its peaks within 2 of its stated u of the truth (measured: 100 %), every
+/// table value within 2 u; suspect since the thirty-sixth session only for its
+/// excursions of 6.8 samples ([`assert_suspect_only_for_short_inward_arcs`]).
 #[test]
 fn a_test_given_its_campaigns_contacts_carries_their_onset() {
     let (res, truth) = reduced_with_truth("penalty-one-sided-s7");
     let t = res.tests.iter().find(|t| t.spec.id == "E1_155_1").unwrap();
     let r = t.result.as_ref().unwrap();
     print_reading("E1_155_1", r);
-    assert!(
-        r.analysis.quality.is_ok() && r.analysis.contact_phases,
-        "{}",
-        r.analysis.quality.describe()
-    );
+    assert!(r.analysis.contact_phases, "{}", r.analysis.quality.describe());
+    assert_suspect_only_for_short_inward_arcs("E1_155_1", r);
     let tt = truth["tests"].as_array().unwrap().iter().find(|x| x["id"] == "E1_155_1").unwrap();
     assert_peaks_within_2u("E1_155_1", r, tt);
     assert_values_within_2u("E1_155_1", r, tt, f64::INFINITY);
+}
+
+/// A 100 Hz one-sided test of a wall whose contacts last: suspect for its
+/// excursions into the transverse walls alone (fewer than 9 samples each,
+/// `checks::inward_arcs_unresolved`, thirty-sixth session), its reading
+/// otherwise sound. The tests below that check such a reading (its u, its
+/// contacts, its restarts) were written when it was ok.
+fn assert_suspect_only_for_short_inward_arcs(id: &str, r: &rocklab::reduce::Reduced) {
+    let q = &r.analysis.quality;
+    assert!(!q.is_ok() && q.is_ok_but_for_short_inward_arcs(), "{id}: {}", q.describe());
 }
 
 /// Each peak of `r` within 2 of its stated u of the truth's (test `tt` of a
@@ -734,9 +761,10 @@ fn assert_peaks_within_2u(id: &str, r: &rocklab::reduce::Reduced, tt: &serde_jso
 /// zero), read with contact phases (as its campaign's rule reads it): the fit
 /// finds no lead at the free arcs' ends (6.5·10⁻²⁹ s), and until the
 /// twenty-eighth session their peaks carried ± 0.03–0.06 % while read +1.5,
-/// +2.3 and +3.5 % of the truth, r⁻ +0.44 ± 0.01 pp. Asserted: the test is
-/// ok, and every table value within 2 of its stated u (measured: at most
-/// 1.7 u, r₁ −2.67 ± 1.55 pp).
+/// +2.3 and +3.5 % of the truth, r⁻ +0.44 ± 0.01 pp. Asserted: every table
+/// value within 2 of its stated u (measured: at most 1.7 u, r₁ −2.67 ± 1.55
+/// pp), the test suspect only for its excursions of 6.9 samples (ok until the
+/// thirty-sixth session, [`assert_suspect_only_for_short_inward_arcs`]).
 #[test]
 fn a_collapsed_contact_lead_carries_the_unresolved_onset() {
     let options = PeakOptions {
@@ -745,11 +773,8 @@ fn a_collapsed_contact_lead_carries_the_unresolved_onset() {
     };
     let (res, truth) = reduced_with_options("penalty-one-sided-100hz", options);
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(
-        r.analysis.quality.is_ok() && r.analysis.contact_phases,
-        "{}",
-        r.analysis.quality.describe()
-    );
+    assert!(r.analysis.contact_phases, "{}", r.analysis.quality.describe());
+    assert_suspect_only_for_short_inward_arcs("E1_155_1", r);
     assert_values_within_2u("E1_155_1", r, &truth["tests"][0], f64::INFINITY);
 }
 
@@ -1148,8 +1173,9 @@ fn summary_of(name: &str, rep: &[(String, f64, bool, Vec<f64>)]) -> (usize, f64,
 /// This test guards what holds (the two-sided campaign meets the issue's
 /// criterion: at most one test flagged, no ok test beyond 1.0 pp, ≥ 90 % of
 /// the peaks within 2 u; one-sided, at most one flagged and the coverage of
-/// u); `holdouts_meet_the_issue` is the issue's full criterion, not met yet
-/// one-sided.
+/// u); `holdouts_meet_the_issue` is the issue's full criterion, met on the
+/// one-sided campaign too since the thirty-sixth session (H1_150_1 suspect for
+/// its excursions of 6.3 samples, the ok tests within 0.79 pp).
 #[test]
 fn mujoco_holdouts_reduced_or_flagged() {
     assert_issue_18("two-sided", holdout_summary("mujoco-holdout-two-sided"));
@@ -1257,14 +1283,21 @@ fn walls_outside_the_tuned_range_are_flagged_or_within_their_u() {
 /// while the correlated term said their errors cancel). Now it is ok, its
 /// model-form terms carried uncorrelated, and every table value must cover
 /// its error within 2 u (measured: r⁻ +1.19 pp at u 1.03); the test fails
-/// with the term correlated. The other five keep their status.
+/// with the term correlated. The other five keep their status, but for the
+/// 100 Hz H1_150_1, suspect since the thirty-sixth session for its
+/// excursions into the transverse walls (6.3 samples) alone; every test's
+/// values still cover their errors.
 #[test]
 fn a_one_sided_test_whose_exits_misfit_is_ok_with_honest_ratios() {
     let name = "mujoco-holdout-one-sided";
     let (res, truth) = reduced_with_truth(name);
     for t in &res.tests {
         let r = t.result.as_ref().unwrap_or_else(|e| panic!("{}: {e}", t.spec.id));
-        assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        if t.spec.id == "H1_150_1" {
+            assert_suspect_only_for_short_inward_arcs("H1_150_1", r);
+        } else {
+            assert!(r.analysis.quality.is_ok(), "{}: {}", t.spec.id, r.analysis.quality.describe());
+        }
         if t.spec.id == "H1_140_1" {
             // The report and summary.json say what the fit misses and what was done.
             let note = r.analysis.model_note.as_deref().unwrap_or_default();
@@ -1365,14 +1398,14 @@ fn a_partly_shared_model_spread_covers_the_ratios_errors() {
 
 /// The issue's criterion on both hold-out campaigns: at most one test flagged
 /// per campaign, every value of the ok tests within 1.0 pp, ≥ 90 % of peaks
-/// within 2 u. Fails today on the one-sided campaign (see
-/// `mujoco_holdouts_reduced_or_flagged`): r₁ = v₁/v₀ of H1_150_1 (100 Hz,
-/// 1.18 pp at u 2.83 pp; r⁻ of H1_140_1, 1.19 pp, until the thirty-fourth
-/// session read its late landing by the contact model),
-/// where the wall leaves the transverse walls (docs/accuracy.md,
-/// "One-sided: the exit from the inward side, and the restraint's amplitude").
+/// within 2 u. Not met on the one-sided campaign until the thirty-sixth
+/// session: r₁ = v₁/v₀ of H1_150_1 (100 Hz) was ok at 1.18 pp off (u 2.83 pp;
+/// r⁻ of H1_140_1, 1.19 pp, until the thirty-fourth session read its late
+/// landing by the contact model). Its excursions into the transverse walls
+/// span 6.3 samples, and it is suspect for that since
+/// (`checks::inward_arcs_unresolved`): one test flagged, the ok ones within
+/// 0.79 pp. The two-sided campaign: one flagged (H2_70_1), within 0.26 pp.
 #[test]
-#[ignore = "issue 18's criterion on the hold-outs, not met yet: a one-sided ok test 1.18 pp off"]
 fn holdouts_meet_the_issue() {
     for name in ["mujoco-holdout-two-sided", "mujoco-holdout-one-sided"] {
         assert_issue_18(name, holdout_summary(name));
@@ -1457,8 +1490,10 @@ fn an_undetermined_fit_states_no_zero_uncertainty() {
 /// restart from γ = 10 s⁻¹ fitted the log better than the first fit, but read
 /// |v₂| > |v₁| and |v₄| > |v₃| (an outward impact with e ≈ 1.004–1.008), and
 /// was taken: the test was ok with r⁻ 2.17 pp off (thirtieth session). The
-/// first fit stands now. Asserted: ok, every table value within 1 pp and
-/// within 2 of its u (measured: at most 0.94 pp).
+/// first fit stands now. Asserted: the peaks lose speed, every table value
+/// within 1 pp and within 2 of its u (measured: at most 0.94 pp); ok until the
+/// thirty-sixth session, suspect since only for its excursions of 6.2 samples
+/// ([`assert_suspect_only_for_short_inward_arcs`]).
 #[test]
 fn a_restart_that_gains_energy_is_no_reading() {
     let options = PeakOptions {
@@ -1468,7 +1503,7 @@ fn a_restart_that_gains_energy_is_no_reading() {
     };
     let (res, truth) = reduced_with_options("mujoco-one-sided-restart-gains", options);
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(r.analysis.quality.is_ok(), "{}", r.analysis.quality.describe());
+    assert_suspect_only_for_short_inward_arcs("Q1_155_1", r);
     let v: Vec<f64> = r.analysis.peaks.iter().map(|p| p.velocity_mm_s.abs()).collect();
     assert!(v.windows(2).all(|w| w[1] <= w[0]), "{v:?}");
     assert_values_within_2u("Q1_155_1", r, &truth["tests"][0], 0.01);

@@ -293,7 +293,14 @@ fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: V
             continue;
         }
         let again = reduce_loaded(campaign, &t.spec, r.log.clone(), &expected);
-        let fits = |o: &TestOutcome| o.result.as_ref().is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok());
+        // A reading with contact phases that is sound but for a one-sided wall's
+        // excursions spanning too few samples (`checks::inward_arcs_unresolved`)
+        // is taken too: the test stays suspect for that, with the wall's contacts.
+        let fits = |o: &TestOutcome| {
+            o.result
+                .as_ref()
+                .is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok_but_for_short_inward_arcs())
+        };
         if fits(&again) {
             t.result = again.result;
             t.warnings.push(format!(

@@ -16,6 +16,7 @@
 //! | [`undetermined_parameters`] | a peak read from the global fit depends on a direction of its parameters that the log does not determine and does not bound (its uncertainty cannot be computed) |
 //! | [`not_a_covariance`] | the peaks' covariance is not finite, symmetric and positive semi-definite with a positive variance for every peak |
 //! | [`disagreement`] | the local re-fit of an arc's end disagrees with the global fit by more than 4 combined standard uncertainties + 3 % |
+//! | [`inward_arcs_unresolved`] | one-sided, the wall's contacts last (contact phases fitted, or shown by the campaign's other tests), and an inward half-cycle of the table spans fewer than 9 samples |
 //! | [`kink_disagreement`] | one-sided, contact phases and no filter, or an estimated FIR: the log's slope into the crossing that ends a free arc disagrees with the global fit's peak as [`disagreement`] |
 //!
 //! The thresholds were set on the random draws of `tests/random_draw.rs`: a
@@ -219,6 +220,50 @@ pub fn contacts_too_long(m: &super::model::Model, windows: &[(f64, f64)], table:
 /// Half-cycle s is an inward arc against the transverse walls (one-sided, s odd).
 pub fn inward_arcs(m: &super::model::Model) -> Vec<bool> {
     (0..m.m()).map(|s| m.one_sided && s % 2 == 1).collect()
+}
+
+/// The fewest samples an inward half-cycle of a one-sided wall with
+/// finite-duration contacts may span for its test to be vouched for: 9.
+/// Measured on the 76 engine-made campaigns (`tests/truth.rs`,
+/// `engine_campaigns`, thirty-sixth session; the inward half-cycles' lengths
+/// from the engine's zero crossings): of the one-sided tests whose shortest
+/// inward half-cycle spans fewer than 9 samples, 8 of the 25 that passed every
+/// other check read a table value 1.0–2.7 pp off (2 more than 2 pp off), and 23
+/// of 48 were flagged for other reasons; with 9 or more samples, 16 of 180
+/// (1 more than 2 pp off). Every such test was logged at 100 Hz (5.3–8.4
+/// samples); the 200 Hz tests span 9.5 or more.
+pub const INWARD_ARC_SAMPLES_MIN: f64 = 9.0;
+
+/// What every reason of [`inward_arcs_unresolved`] says, and only it.
+pub const SHORT_INWARD_ARCS: &str = "the pushes that end them cannot be vouched for";
+
+/// A one-sided wall whose contacts last (`contacts`: contact phases fitted,
+/// or other tests of its campaign show them, [`super::Onset::ContactsElsewhere`])
+/// and whose inward half-cycles (the excursions into the transverse walls,
+/// half-cycles 1, 3, 5 between `impact_times` 0–1, 2–3, 4–5) span fewer than
+/// [`INWARD_ARC_SAMPLES_MIN`] samples of `dt`. The push at the end of such an
+/// excursion is the exit from a contact with the restraint that the samples
+/// do not resolve: the contact model cannot read it (its corner falls between
+/// two samples), and the global fit reads it from the few samples of an arc
+/// whose shape the contacts change (on the engine's walls 1.5 % low on
+/// average, 1.7 % scatter, against 1.0 % and 1.2 % at 200 Hz). The reason
+/// begins as [`crate::restitution::unresolved_reason`]'s: the fit's contact
+/// phases still say what the wall's contacts are
+/// (`crate::reduction::campaign_shows_contacts`).
+pub fn inward_arcs_unresolved(impact_times: &[f64], n_peaks: usize, dt: f64, contacts: bool) -> Option<String> {
+    if !contacts || dt <= 0.0 {
+        return None;
+    }
+    let shortest = (1..n_peaks.min(impact_times.len()))
+        .step_by(2)
+        .map(|s| (impact_times[s] - impact_times[s - 1]) / dt)
+        .fold(f64::INFINITY, f64::min);
+    (shortest < INWARD_ARC_SAMPLES_MIN).then(|| {
+        format!(
+            "the log does not resolve the excursions into the transverse walls: the shortest of the table's spans {shortest:.1} samples (fewer than {INWARD_ARC_SAMPLES_MIN:.0}), and on a wall whose contacts last, {SHORT_INWARD_ARCS} within 1 pp (engine-made walls: 8 of 25 such tests read a value 1.0–2.7 pp off): log at {:.0} Hz or more",
+            (INWARD_ARC_SAMPLES_MIN / shortest / dt).ceil()
+        )
+    })
 }
 
 /// Inside a contact phase the velocity may still rise a little before it falls,
@@ -458,6 +503,25 @@ mod tests {
         assert!(contact_too_long(&[(0.05, 0.01)], &arcs, &[false; 4], 3).unwrap().contains("impact 2"));
         let one_sided = [false, true, false, false];
         assert!(contact_too_long(&long_lag, &arcs, &one_sided, 3).unwrap().contains("impact 2"));
+    }
+
+    /// Inward half-cycles 1, 3, 5 of 60, 58 and 57 ms between longer free
+    /// arcs: 5.7 samples at 100 Hz trip, 11.4 at 200 Hz do not; without
+    /// lasting contacts nothing trips (an idealised log's impacts are sharp).
+    #[test]
+    fn inward_arcs_of_fewer_than_nine_samples_trip_where_contacts_last() {
+        let zeros = [0.5, 0.56, 1.0, 1.058, 1.4, 1.457, 1.7];
+        let why = inward_arcs_unresolved(&zeros, 6, 0.01, true).unwrap();
+        assert!(why.contains("spans 5.7 samples"), "{why}");
+        assert!(why.contains("log at 158 Hz or more"), "{why}");
+        assert!(crate::restitution::is_unresolved_reason(&why));
+        assert!(inward_arcs_unresolved(&zeros, 6, 0.005, true).is_none());
+        assert!(inward_arcs_unresolved(&zeros, 6, 0.01, false).is_none());
+        // Only the table's half-cycles count: a short fourth excursion after
+        // peak 5 does not.
+        let late_short = [0.5, 0.6, 1.0, 1.1, 1.4, 1.5, 1.7, 1.73];
+        assert!(inward_arcs_unresolved(&late_short, 6, 0.01, true).is_none());
+        assert!(inward_arcs_unresolved(&late_short, 8, 0.01, true).is_some());
     }
 
     #[test]

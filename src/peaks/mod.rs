@@ -397,6 +397,15 @@ impl Quality {
             }
         }
     }
+    /// Ok, or suspect only because a one-sided wall's excursions into the
+    /// transverse walls span too few samples for its lasting contacts
+    /// ([`checks::inward_arcs_unresolved`]): a reading that is otherwise sound.
+    pub fn is_ok_but_for_short_inward_arcs(&self) -> bool {
+        match self {
+            Quality::Ok => true,
+            Quality::Suspect(r) => r.iter().all(|w| w.contains(checks::SHORT_INWARD_ARCS)),
+        }
+    }
     /// "ok", or "suspect: reason; reason".
     pub fn describe(&self) -> String {
         match self {
@@ -417,9 +426,23 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
             if !replaced {
                 a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(deferred);
             }
+            if phys.rocking == crate::wall::Rocking::OneSided {
+                let unresolved = unresolved_inward_arcs(&a, t, opts);
+                a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(unresolved);
+            }
             a
         }),
     }
+}
+
+/// [`checks::inward_arcs_unresolved`] on a one-sided analysis: its contacts
+/// last where it has contact phases or the campaign's other tests show them
+/// ([`Onset::ContactsElsewhere`]).
+fn unresolved_inward_arcs(a: &Analysis, t: &[f64], opts: &PeakOptions) -> Option<String> {
+    let dt = median(&t.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+    let times: Vec<f64> = a.impacts.iter().map(|i| i.time_s).collect();
+    let contacts = a.contact_phases || opts.onset == Onset::ContactsElsewhere;
+    checks::inward_arcs_unresolved(&times, a.peaks.len(), dt, contacts)
 }
 
 /// A log made ready for either estimator.

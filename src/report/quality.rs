@@ -22,6 +22,9 @@ pub enum Kind {
     /// No filter stated, and two responses (two filter families, or a filter and
     /// compliant contacts) fit the log with ratios that differ.
     FilterUnknown,
+    /// A one-sided wall whose contacts last, with inward half-cycles of fewer
+    /// than 9 samples ([`crate::peaks::checks::inward_arcs_unresolved`]).
+    ShortInwardArcs,
     /// A ratio of the tables read to more than ± 5 pp
     /// ([`crate::restitution::RATIO_U_MAX`]).
     Unresolved,
@@ -42,6 +45,7 @@ const PHRASES: &[(&str, Kind)] = &[
     ("the contact model overshoots", Kind::ContactOvershoot),
     ("does not settle where the half-cycle ends", Kind::ZeroReadings),
     ("the logger's filter is not stated and the log cannot tell", Kind::FilterUnknown),
+    (crate::peaks::checks::SHORT_INWARD_ARCS, Kind::ShortInwardArcs),
     ("a ratio read to more than", Kind::Unresolved),
 ];
 
@@ -154,6 +158,12 @@ pub fn advice(kind: Kind) -> Advice {
             how_far: "On 200 synthetic tests with compliant contacts and no filter stated, the 6 flagged for this were off by 2.00 pp at the median and 5.75 pp at worst (the worst of the seven values of each test); on 500 idealised tests, the one flagged for this was 0.04 pp off (docs/accuracy.md).",
             rerun: "state the logger's filter in the manifest's [acquisition] (type, order and cut-off from the logger's data sheet; filter = \"none\" if it has none) and re-run reduce.",
         },
+        Kind::ShortInwardArcs => Advice {
+            title: "The excursions into the transverse walls span too few samples for a wall whose contacts last.",
+            look: "the velocity panel of the motion plot over the inward half-cycles (the short excursions below zero): how many samples span each, and whether the push at the end of each falls between two samples.",
+            how_far: "On engine-made one-sided walls with fewer than 9 samples per excursion (all logged at 100 Hz), 8 of the 25 tests that passed every other check read a value 1.0–2.7 pp off, each within 2 of its stated u; with 9 samples or more, 16 of 180 were more than 1 pp off (docs/accuracy.md, \"Thirty-sixth session\").",
+            rerun: "log at the rate the reason names or higher (9 samples or more per excursion); until then the values hold only as far as their u says.",
+        },
         Kind::Unresolved => Advice {
             title: "Some ratios are read too loosely to use: their standard uncertainty is above 5 pp.",
             look: "the velocity panel of the motion plot at the peaks named: how many samples span each, and how large the noise is beside them.",
@@ -254,6 +264,10 @@ mod tests {
                     },
                 ),
                 Kind::FilterUnknown,
+            ),
+            (
+                checks::inward_arcs_unresolved(&[0.5, 0.56, 1.0, 1.06, 1.4, 1.46], 6, 0.01, true),
+                Kind::ShortInwardArcs,
             ),
             (unresolved_case(), Kind::Unresolved),
         ];

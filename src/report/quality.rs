@@ -160,7 +160,7 @@ pub fn advice(kind: Kind) -> Advice {
         },
         Kind::ShortInwardArcs => Advice {
             title: "The excursions into the transverse walls span too few samples for a wall whose contacts last.",
-            look: "the velocity panel of the motion plot over the inward half-cycles (the short excursions below zero): how many samples span each, and whether the push at the end of each falls between two samples.",
+            look: "the motion plot over the short excursions below zero (the inward half-cycles; in the velocity panel, each steep rise): the reason says how many samples span the shortest, the fit is drawn over them, and the push at each excursion's end, the velocity's top, falls between two of them.",
             how_far: "On engine-made one-sided walls with fewer than 9 samples per excursion (all logged at 100 Hz), 8 of the 25 tests that passed every other check read a value 1.0–2.7 pp off, each within 2 of its stated u; with 9 samples or more, 16 of 180 were more than 1 pp off (docs/accuracy.md, \"Thirty-sixth session\").",
             rerun: "log at the rate the reason names or higher (9 samples or more per excursion); until then the values hold only as far as their u says.",
         },

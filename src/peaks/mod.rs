@@ -418,6 +418,7 @@ impl Quality {
 /// Analyse one log: `t` in s (strictly increasing), `x` in mm outward positive.
 pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Result<Analysis, PeakError> {
     let prepared = prepare_log(t, x, opts.n_peaks)?;
+    let dt = prepared.dt;
     match opts.method {
         Method::SavGol(filter) => Ok(by_savgol(t, prepared, filter, opts.n_peaks)),
         Method::Segments => by_segments(t, prepared, phys, opts).map(|mut a| {
@@ -427,7 +428,7 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
                 a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(deferred);
             }
             if phys.rocking == crate::wall::Rocking::OneSided {
-                let unresolved = unresolved_inward_arcs(&a, t, opts);
+                let unresolved = unresolved_inward_arcs(&a, dt, opts);
                 a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(unresolved);
             }
             a
@@ -437,9 +438,9 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
 
 /// [`checks::inward_arcs_unresolved`] on a one-sided analysis: its contacts
 /// last where it has contact phases or the campaign's other tests show them
-/// ([`Onset::ContactsElsewhere`]).
-fn unresolved_inward_arcs(a: &Analysis, t: &[f64], opts: &PeakOptions) -> Option<String> {
-    let dt = median(&t.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+/// ([`Onset::ContactsElsewhere`]); `dt` the log's median sample interval
+/// (`prepare_log`).
+fn unresolved_inward_arcs(a: &Analysis, dt: f64, opts: &PeakOptions) -> Option<String> {
     let times: Vec<f64> = a.impacts.iter().map(|i| i.time_s).collect();
     let contacts = a.contact_phases || opts.onset == Onset::ContactsElsewhere;
     checks::inward_arcs_unresolved(&times, a.peaks.len(), dt, contacts)

@@ -144,6 +144,10 @@ impl Uncertainty {
 
 /// The coefficients of a set as distributions: one e both ways (two-sided
 /// rocking, Housner), e_in and e_out, or a restitution law.
+// The law variant is larger than the others (two sides' 3×3 covariances where a
+// side has an energy term); a study holds a handful of sets, and boxing the law
+// would lose `Copy`, on which the draws rely.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CoefficientDist {
@@ -171,7 +175,16 @@ impl CoefficientDist {
             CoefficientDist::Pair { e_in, e_out } => e_in.is_random() || e_out.is_random(),
             CoefficientDist::Law { law, drawn, .. } => {
                 let p = &law.parameters;
-                *drawn && p.inward.cov.iter().chain(&p.outward.cov).flatten().any(|v| *v != 0.0)
+                let energy = [p.inward.energy, p.outward.energy].into_iter().flatten().flat_map(|e| e.cov).flatten();
+                *drawn
+                    && p.inward
+                        .cov
+                        .iter()
+                        .chain(&p.outward.cov)
+                        .flatten()
+                        .copied()
+                        .chain(energy)
+                        .any(|v| v != 0.0)
             }
         }
     }

@@ -174,6 +174,7 @@ impl LawPacking {
             c: s[1],
             cov: [[0.0; 2]; 2],
             g: Shape::Free,
+            energy: None,
         };
         Some(RestitutionLaw {
             form: LawForm::SpeedLoss,
@@ -450,6 +451,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
                 c: s.c,
                 cov: s.cov,
                 g: Shape::Free,
+                energy: None,
             }
         } else {
             SideLaw::constant(s.constant_r, s.constant_u)

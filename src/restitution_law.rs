@@ -54,6 +54,23 @@
 //! the fit ([`crate::law_fit`]) says whether the data reject it. A two-sided campaign
 //! fits one law for both sides (`shared`: in and out are equal and drawn together).
 //!
+//! # A loss of energy too (form `"speed-and-energy-loss"`, thirty-seventh session)
+//!
+//!   r(a) = r∞ − c g(a) − c₂ q(g(a)),   q(g) = g² over the side's observed g,
+//!
+//! and the tangent of g² beyond them ([`EnergyLoss`]). A compliant contact that
+//! lasts longer as the impact speed falls loses more than a fixed Δω: each test
+//! follows r∞ − c g^q with q 1.3–2.9 (above). The next term of the loss in powers of
+//! 1/ω⁻ is a fixed loss of *energy* ΔE per impact: ω⁺² = e∞² ω⁻² − 2ΔE/I₀ gives
+//! e ≈ e∞ − ΔE/(I₀ e∞ ω⁻²), a term in g². The three losses (proportional, speed,
+//! energy) nest: c₂ = 0 is the speed-loss law, c = c₂ = 0 the constant. The fit
+//! ([`crate::law_fit`], "A loss of energy too") applies the term only where
+//! Akaike's criterion prefers it to both nested forms, c₂ > 0 (a loss), and r falls
+//! with g from g = 1 on (c + 2 c₂ g_lo ≥ 0), so the law stays monotone in a and its
+//! extrapolation above the data is the tangent's, a short step (g(a_max) ≈ 1.1–1.4
+//! on the free arc). The 3×3 covariance of (r∞, c, c₂) gives u(r) and the draws;
+//! the side's `cov` is its upper-left block.
+//!
 //! # Range
 //! Above the largest amplitude the campaign observed the form extrapolates to a = 1,
 //! where g is bounded (g(1) = 1), which is what a façade near overturning needs.
@@ -65,7 +82,8 @@
 //! caps e = r e_H at 1.
 //!
 //! # Uncertainty and draws
-//! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c).
+//! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c)
+//! (with the energy term ∇ = (1, −g, −q(g)) and its 3×3 covariance).
 //! [`RestitutionLaw::sample`] draws the parameters as mean + L z with L Σ's Cholesky
 //! factor and z standard normals given by the caller (the core stays deterministic).
 
@@ -79,6 +97,9 @@ pub enum LawForm {
     Constant,
     /// r = r∞ − c / √(a (2 − a)): a proportional loss plus a fixed speed loss.
     SpeedLoss,
+    /// r = r∞ − c g − c₂ g² on some side ([`EnergyLoss`]): a fixed loss of energy
+    /// per impact besides the speed loss (module docs, "A loss of energy too").
+    SpeedAndEnergyLoss,
 }
 
 impl LawForm {
@@ -86,6 +107,7 @@ impl LawForm {
         match self {
             LawForm::Constant => "constant",
             LawForm::SpeedLoss => "speed-loss",
+            LawForm::SpeedAndEnergyLoss => "speed-and-energy-loss",
         }
     }
 }
@@ -125,6 +147,15 @@ impl Shape {
     pub fn is_free(&self) -> bool {
         *self == Shape::Free
     }
+
+    /// The amplitude a ∈ (0, 1] at which g(a) = `g` (g ≥ 1): a(2 − a) = 1/g² on
+    /// the free arc, a = 1/g for the push.
+    pub fn eval_inverse(self, g: f64) -> f64 {
+        match self {
+            Shape::Free => 1.0 - (1.0 - 1.0 / (g * g)).max(0.0).sqrt(),
+            Shape::Push => 1.0 / g,
+        }
+    }
 }
 
 /// The parameters of one side: r∞, c and their covariance [[var r∞, cov], [cov, var c]],
@@ -136,6 +167,33 @@ pub struct SideLaw {
     pub cov: [[f64; 2]; 2],
     #[serde(default, skip_serializing_if = "Shape::is_free")]
     pub g: Shape,
+    /// The energy-loss term c₂ q(g) and the covariance of (r∞, c, c₂), where the
+    /// side applies it (form `"speed-and-energy-loss"`); absent otherwise, so laws
+    /// written before it read and give the same r bit for bit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy: Option<EnergyLoss>,
+}
+
+/// A fixed loss of energy per impact on one side (module docs, "A loss of energy
+/// too"): r = r∞ − c g − c₂ q(g), q(g) = g² over the side's observed shapes
+/// [g_lo, g_hi] and its tangent outside them (2 g_e g − g_e² beyond the edge g_e),
+/// so that the law extrapolates as the speed-loss form does, from the edge's slope.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EnergyLoss {
+    pub c2: f64,
+    /// Covariance of (r∞, c, c₂); its upper-left block is the side's `cov`.
+    pub cov: [[f64; 3]; 3],
+    /// g at the side's largest and smallest observed amplitudes.
+    pub g_lo: f64,
+    pub g_hi: f64,
+}
+
+impl EnergyLoss {
+    /// q(g): g² on [g_lo, g_hi], the tangent of g² at the nearer edge outside.
+    pub fn q(&self, g: f64) -> f64 {
+        let e = g.clamp(self.g_lo, self.g_hi);
+        2.0 * e * g - e * e
+    }
 }
 
 impl SideLaw {
@@ -146,29 +204,69 @@ impl SideLaw {
             c: 0.0,
             cov: [[u * u, 0.0], [0.0, 0.0]],
             g: Shape::Free,
+            energy: None,
         }
     }
 
-    /// r∞ − c g, not clamped.
+    /// r∞ − c g − c₂ q(g), not clamped.
     fn value(&self, g: f64) -> f64 {
-        self.r_inf - self.c * g
+        let energy = self.energy.map_or(0.0, |e| e.c2 * e.q(g));
+        self.r_inf - self.c * g - energy
     }
 
-    /// u(r∞ − c g) = √(Σ₀₀ − 2 g Σ₀₁ + g² Σ₁₁).
+    /// dr/dg at g (the side's r falls as the amplitude falls where it is negative).
+    fn slope(&self, g: f64) -> f64 {
+        let energy = self.energy.map_or(0.0, |e| 2.0 * e.c2 * g.clamp(e.g_lo, e.g_hi));
+        -self.c - energy
+    }
+
+    /// u(r) = √(∇ᵀ Σ ∇), ∇ = (1, −g) or (1, −g, −q(g)).
     fn u(&self, g: f64) -> f64 {
-        let s = &self.cov;
-        (s[0][0] - 2.0 * g * s[0][1] + g * g * s[1][1]).max(0.0).sqrt()
+        match &self.energy {
+            None => {
+                let s = &self.cov;
+                (s[0][0] - 2.0 * g * s[0][1] + g * g * s[1][1]).max(0.0).sqrt()
+            }
+            Some(e) => {
+                let d = [1.0, -g, -e.q(g)];
+                let v: f64 = (0..3)
+                    .flat_map(|i| (0..3).map(move |j| (i, j)))
+                    .map(|(i, j)| d[i] * e.cov[i][j] * d[j])
+                    .sum();
+                v.max(0.0).sqrt()
+            }
+        }
     }
 
     /// mean + L z, L the lower Cholesky factor of the covariance (a singular or
     /// zero covariance gives zero rows, so a constant law draws only r∞).
-    fn sample(&self, z0: f64, z1: f64) -> SideLaw {
-        let (l00, l10, l11) = cholesky2(&self.cov);
-        SideLaw {
-            r_inf: self.r_inf + l00 * z0,
-            c: self.c + l10 * z0 + l11 * z1,
-            cov: [[0.0; 2]; 2],
-            g: self.g,
+    fn sample(&self, z: [f64; 3]) -> SideLaw {
+        match &self.energy {
+            None => {
+                let (l00, l10, l11) = cholesky2(&self.cov);
+                SideLaw {
+                    r_inf: self.r_inf + l00 * z[0],
+                    c: self.c + l10 * z[0] + l11 * z[1],
+                    cov: [[0.0; 2]; 2],
+                    g: self.g,
+                    energy: None,
+                }
+            }
+            Some(e) => {
+                let l = cholesky3(&e.cov);
+                let dx: Vec<f64> = (0..3).map(|i| (0..=i).map(|j| l[i][j] * z[j]).sum()).collect();
+                SideLaw {
+                    r_inf: self.r_inf + dx[0],
+                    c: self.c + dx[1],
+                    cov: [[0.0; 2]; 2],
+                    g: self.g,
+                    energy: Some(EnergyLoss {
+                        c2: e.c2 + dx[2],
+                        cov: [[0.0; 3]; 3],
+                        ..*e
+                    }),
+                }
+            }
         }
     }
 
@@ -188,8 +286,65 @@ impl SideLaw {
         if s[0][0] < 0.0 || s[1][1] < 0.0 || s[0][1] * s[0][1] > s[0][0] * s[1][1] * (1.0 + 1e-9) + 1e-300 {
             return Err(format!("{what}: covariance is not positive semi-definite"));
         }
+        match &self.energy {
+            Some(e) => e.validate(what, s),
+            None => Ok(()),
+        }
+    }
+}
+
+impl EnergyLoss {
+    fn validate(&self, what: &str, block: &[[f64; 2]; 2]) -> Result<(), String> {
+        let s = &self.cov;
+        let finite = self.c2.is_finite() && self.g_lo.is_finite() && self.g_hi.is_finite() && s.iter().flatten().all(|x| x.is_finite());
+        if !finite {
+            return Err(format!("{what}: the energy term and its covariance must be finite numbers"));
+        }
+        if !(self.g_lo >= 1.0 && self.g_lo <= self.g_hi) {
+            return Err(format!(
+                "{what}: the energy term's shapes [{}, {}] must satisfy 1 ≤ g_lo ≤ g_hi",
+                self.g_lo, self.g_hi
+            ));
+        }
+        let scale = (0..3).map(|i| s[i][i].abs()).sum::<f64>().max(1e-300);
+        let symmetric = (0..3).all(|i| (0..3).all(|j| (s[i][j] - s[j][i]).abs() <= 1e-9 * scale));
+        if !symmetric {
+            return Err(format!("{what}: the energy term's covariance is not symmetric"));
+        }
+        let agrees = (0..2).all(|i| (0..2).all(|j| (s[i][j] - block[i][j]).abs() <= 1e-9 * scale));
+        if !agrees {
+            return Err(format!("{what}: \"cov\" must be the upper-left block of the energy term's covariance"));
+        }
+        if !positive_semi_definite3(s) {
+            return Err(format!("{what}: the energy term's covariance is not positive semi-definite"));
+        }
         Ok(())
     }
+}
+
+/// Lower Cholesky factor of a 3×3 positive semi-definite matrix (rows of a
+/// singular direction are zero).
+fn cholesky3(s: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut l = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..=i {
+            let sum: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
+            if i == j {
+                l[i][i] = (s[i][i] - sum).max(0.0).sqrt();
+            } else {
+                l[i][j] = if l[j][j] > 0.0 { (s[i][j] - sum) / l[j][j] } else { 0.0 };
+            }
+        }
+    }
+    l
+}
+
+/// Whether L Lᵀ (the Cholesky factor of `s`) gives back `s` to a relative 1e-9:
+/// a negative pivot, clamped to 0, does not.
+fn positive_semi_definite3(s: &[[f64; 3]; 3]) -> bool {
+    let l = cholesky3(s);
+    let scale = (0..3).map(|i| s[i][i].abs()).sum::<f64>().max(1e-300);
+    (0..3).all(|i| s[i][i] >= 0.0) && (0..3).all(|i| (0..3).all(|j| ((0..3).map(|k| l[i][k] * l[j][k]).sum::<f64>() - s[i][j]).abs() <= 1e-6 * scale))
 }
 
 /// Lower Cholesky factor (l00, l10, l11) of a 2×2 positive semi-definite matrix.
@@ -301,17 +456,23 @@ impl RestitutionLaw {
     }
 
     /// g at the amplitude for one side (module docs, "Range"): a clamped to
-    /// [AMPLITUDE_FLOOR, 1] where c ≥ 0 and to [amplitude_min, 1] where c < 0
+    /// [AMPLITUDE_FLOOR, 1] where r falls as the amplitude falls below the
+    /// observed ones (c ≥ 0; with an energy term, a slope dr/dg ≤ 0 at the
+    /// smallest observed amplitude) and to [amplitude_min, 1] where it would rise
     /// (the inward side: [inward_amplitude_min, 1] where it is given); 0 for a
     /// constant, so that r = r∞ exactly.
     fn g(&self, which: Side, amplitude_over_alpha: f64) -> f64 {
         let side = self.side(which);
         match self.form {
             LawForm::Constant => 0.0,
-            LawForm::SpeedLoss => {
+            LawForm::SpeedLoss | LawForm::SpeedAndEnergyLoss => {
                 let a = amplitude_over_alpha.abs();
                 let a = if a.is_finite() { a } else { 1.0 };
-                let lo = match (side.c >= 0.0, which, self.parameters.inward_amplitude_min) {
+                let falls = match &side.energy {
+                    None => side.c >= 0.0,
+                    Some(e) => side.slope(e.g_hi) <= 0.0,
+                };
+                let lo = match (falls, which, self.parameters.inward_amplitude_min) {
                     (true, _, _) => AMPLITUDE_FLOOR,
                     (false, Side::Inward, Some(a_in)) => a_in.max(self.parameters.amplitude_min),
                     (false, _, _) => self.parameters.amplitude_min,
@@ -322,7 +483,7 @@ impl RestitutionLaw {
     }
 
     /// r of an impact entering `side` that ends a half-cycle of apex |θ|/α =
-    /// `amplitude_over_alpha`: max(0, r∞ − c g(a)).
+    /// `amplitude_over_alpha`: max(0, r∞ − c g(a) − c₂ q(g(a))).
     pub fn r(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
         let l = self.side(side);
         l.value(self.g(side, amplitude_over_alpha)).max(0.0)
@@ -342,8 +503,9 @@ impl RestitutionLaw {
     /// The smallest amplitude a ∈ [amplitude_min, 1] at which the solver's
     /// e = min(1, r(a) e_H) reaches its cap 1 (a perfectly elastic impact), to 0.1 %
     /// of a; `None` where it never does. r(a) = r∞ − c g(a) is monotone in a for
-    /// either sign of c, so the first of 400 points spaced evenly in ln a that
-    /// reaches the cap, refined by bisection, is the one.
+    /// either sign of c (and a fitted energy term keeps it so: `law_fit` takes one
+    /// only where r falls with g over [1, ∞)), so the first of 400 points spaced
+    /// evenly in ln a that reaches the cap, refined by bisection, is the one.
     pub fn elastic_from(&self, side: Side, e_h: f64) -> Option<f64> {
         let capped = |a: f64| self.r(side, a) * e_h >= 1.0;
         let lo = self.parameters.amplitude_min.clamp(AMPLITUDE_FLOOR, 1.0);
@@ -388,24 +550,31 @@ impl RestitutionLaw {
             .collect()
     }
 
-    /// A draw of the parameters: mean + L z per side with z = (z[0], z[1]) inward and
-    /// (z[2], z[3]) outward (a shared law uses z[0], z[1] for both). The draw has zero
-    /// covariance; its r may leave [0, 1/e_H] only where [`Self::r`] and
-    /// [`Self::e`] clamp it.
-    pub fn sample(&self, z: [f64; 4]) -> RestitutionLaw {
+    /// A draw of the parameters: mean + L z per side with z = (z[0], z[1], z[4])
+    /// inward and (z[2], z[3], z[5]) outward (a shared law uses the inward ones for
+    /// both; z[4], z[5] drive the energy terms, and count as 0 where `z` is
+    /// shorter). The draw has zero covariance; its r may leave [0, 1/e_H] only
+    /// where [`Self::r`] and [`Self::e`] clamp it.
+    pub fn sample(&self, z: &[f64]) -> RestitutionLaw {
+        let at = |i: usize| z.get(i).copied().unwrap_or(0.0);
         let p = &self.parameters;
-        let inward = p.inward.sample(z[0], z[1]);
-        let outward = if p.shared { inward } else { p.outward.sample(z[2], z[3]) };
+        let inward = p.inward.sample([at(0), at(1), at(4)]);
+        let outward = if p.shared { inward } else { p.outward.sample([at(2), at(3), at(5)]) };
         RestitutionLaw {
             form: self.form,
             parameters: LawParameters { inward, outward, ..*p },
         }
     }
 
-    /// [`Self::sample`] with four standard normals from the caller's generator.
+    /// [`Self::sample`] with standard normals from the caller's generator: four,
+    /// and two more where a side has an energy term (so a law without one draws
+    /// the same parameters from the same stream as before the term existed).
     pub fn sample_with(&self, mut normal: impl FnMut() -> f64) -> RestitutionLaw {
-        let z = [normal(), normal(), normal(), normal()];
-        self.sample(z)
+        let mut z = vec![normal(), normal(), normal(), normal()];
+        if self.parameters.inward.energy.is_some() || self.parameters.outward.energy.is_some() {
+            z.extend([normal(), normal()]);
+        }
+        self.sample(&z)
     }
 
     /// Checks what deserialisation cannot: finite parameters in range, a symmetric
@@ -430,6 +599,10 @@ impl RestitutionLaw {
         if self.form == LawForm::Constant && (p.inward.c != 0.0 || p.outward.c != 0.0) {
             return Err("restitution law: form \"constant\" needs c = 0 on both sides".into());
         }
+        let energy = p.inward.energy.is_some() || p.outward.energy.is_some();
+        if energy != (self.form == LawForm::SpeedAndEnergyLoss) {
+            return Err("restitution law: an energy term (\"energy\") goes with form \"speed-and-energy-loss\", and that form needs one".into());
+        }
         if p.shared && p.inward != p.outward {
             return Err("restitution law: a shared law needs equal \"in\" and \"out\" parameters".into());
         }
@@ -451,6 +624,7 @@ mod tests {
             c,
             cov: [[0.0; 2]; 2],
             g: Shape::Free,
+            energy: None,
         };
         let law = |form, inward, outward| RestitutionLaw {
             form,
@@ -484,12 +658,14 @@ mod tests {
                     c: 0.0,
                     cov: [[1e-4, 0.0], [0.0, 1e-6]],
                     g: Shape::Free,
+                    energy: None,
                 },
                 outward: SideLaw {
                     r_inf: 1.02,
                     c: 0.02,
                     cov: [[4e-4, -2e-5], [-2e-5, 4e-6]],
                     g: Shape::Free,
+                    energy: None,
                 },
                 shared: false,
                 amplitude_min: 0.01,
@@ -540,7 +716,7 @@ mod tests {
             assert_eq!(c.r(Side::Inward, a), 0.59);
             assert_eq!(c.r(Side::Outward, a), 0.68);
         }
-        let d = c.sample([1.0, 5.0, -1.0, 5.0]);
+        let d = c.sample(&[1.0, 5.0, -1.0, 5.0]);
         assert!((d.parameters.inward.r_inf - 0.60).abs() < 1e-12);
         assert!((d.parameters.outward.r_inf - 0.66).abs() < 1e-12);
         assert_eq!((d.parameters.inward.c, d.parameters.outward.c), (0.0, 0.0));
@@ -563,7 +739,7 @@ mod tests {
         let mut s = l;
         s.parameters.shared = true;
         s.parameters.outward = s.parameters.inward;
-        let d = s.sample([0.3, -0.2, 9.0, 9.0]);
+        let d = s.sample(&[0.3, -0.2, 9.0, 9.0]);
         assert_eq!(d.parameters.inward, d.parameters.outward);
     }
 
@@ -611,7 +787,7 @@ mod tests {
         assert!(s.contains("\"g\":\"push\""), "{s}");
         assert_eq!(serde_json::from_str::<RestitutionLaw>(&s).unwrap(), pushed);
         // A draw keeps the shape.
-        assert_eq!(pushed.sample([0.1, 0.2, 0.3, 0.4]).parameters.outward.g, Shape::Push);
+        assert_eq!(pushed.sample(&[0.1, 0.2, 0.3, 0.4]).parameters.outward.g, Shape::Push);
         assert!(serde_json::from_str::<RestitutionLaw>(&old.replace("\"out\":{", "\"out\":{\"g\":\"spring\",")).is_err());
     }
 
@@ -639,5 +815,125 @@ mod tests {
             .contains("amplitude"));
         let bad = s.replace("speed-loss", "constant");
         assert!(serde_json::from_str::<RestitutionLaw>(&bad).unwrap_err().to_string().contains("c = 0"));
+    }
+
+    /// A two-sided law with the energy term: r∞ 1, c 0.02, c₂ 0.01 over
+    /// g ∈ [g(0.4), g(0.04)], and a 3×3 covariance whose upper-left block is `cov`.
+    fn energy_law() -> RestitutionLaw {
+        let cov3 = [[1e-4, 1e-5, -1e-6], [1e-5, 4e-6, -2e-7], [-1e-6, -2e-7, 1e-7]];
+        let side = SideLaw {
+            r_inf: 1.0,
+            c: 0.02,
+            cov: [[1e-4, 1e-5], [1e-5, 4e-6]],
+            g: Shape::Free,
+            energy: Some(EnergyLoss {
+                c2: 0.01,
+                cov: cov3,
+                g_lo: speed_shape(0.4),
+                g_hi: speed_shape(0.04),
+            }),
+        };
+        RestitutionLaw {
+            form: LawForm::SpeedAndEnergyLoss,
+            parameters: LawParameters {
+                inward: side,
+                outward: side,
+                shared: true,
+                amplitude_min: 0.04,
+                amplitude_max: 0.4,
+                inward_amplitude_min: None,
+            },
+        }
+    }
+
+    /// The energy term by hand: r = r∞ − c g − c₂ q(g) with q = g² inside the
+    /// observed shapes and the tangent of g² outside (both sides of the range);
+    /// u from the 3×3 covariance; below the smallest amplitude r keeps falling
+    /// (the slope at g_hi is negative), so a is not held there.
+    #[test]
+    fn the_energy_term_by_hand() {
+        let l = energy_law();
+        let (lo, hi) = (speed_shape(0.4), speed_shape(0.04));
+        let r = |g: f64, q: f64| 1.0 - 0.02 * g - 0.01 * q;
+        let g = speed_shape(0.1);
+        assert!((l.r(Side::Inward, 0.1) - r(g, g * g)).abs() < 1e-15);
+        // a = 1: g = 1 < g_lo, the tangent at g_lo.
+        assert!((l.r(Side::Outward, 1.0) - r(1.0, 2.0 * lo - lo * lo)).abs() < 1e-15);
+        // a = 0.01: g beyond g_hi, the tangent at g_hi, not held at a = 0.04.
+        let g = speed_shape(0.01);
+        assert!((l.r(Side::Inward, 0.01) - r(g, 2.0 * hi * g - hi * hi)).abs() < 1e-15);
+        assert!(l.r(Side::Inward, 0.01) < l.r(Side::Inward, 0.04));
+        // u = √(dᵀ Σ d), d = (1, −g, −q).
+        let g = speed_shape(0.1);
+        let d = [1.0, -g, -g * g];
+        let cov = l.parameters.inward.energy.unwrap().cov;
+        let v: f64 = (0..3).map(|i| (0..3).map(|j| d[i] * cov[i][j] * d[j]).sum::<f64>()).sum();
+        assert!((l.r_u(Side::Inward, 0.1) - v.sqrt()).abs() < 1e-15);
+        // The curve is continuous at the edges (the tangent meets the parabola).
+        let eps = 1e-9;
+        for a in [0.4, 0.04] {
+            assert!((l.r(Side::Inward, a * (1.0 + eps)) - l.r(Side::Inward, a * (1.0 - eps))).abs() < 1e-8);
+        }
+    }
+
+    /// Draws of a law with the energy term have its 3×3 covariance; a law
+    /// without one takes four normals from the caller's stream, one with it six.
+    #[test]
+    fn energy_draws_have_the_covariance_and_leave_other_laws_streams_alone() {
+        let l = energy_law();
+        let mut rng = crate::stats::SplitMix64::new(11);
+        let n = 40_000;
+        let draws: Vec<[f64; 3]> = (0..n)
+            .map(|_| {
+                let d = l.sample_with(|| rng.normal()).parameters.inward;
+                [d.r_inf, d.c, d.energy.unwrap().c2]
+            })
+            .collect();
+        let mean: Vec<f64> = (0..3).map(|i| draws.iter().map(|d| d[i]).sum::<f64>() / n as f64).collect();
+        let want = l.parameters.inward.energy.unwrap().cov;
+        for i in 0..3 {
+            for j in 0..=i {
+                let c = draws.iter().map(|d| (d[i] - mean[i]) * (d[j] - mean[j])).sum::<f64>() / n as f64;
+                // √(2/n) ≈ 0.7 % relative on a variance; a covariance's error
+                // scales with √(Σᵢᵢ Σⱼⱼ / n): 5 % of that scale allowed.
+                let scale = (want[i][i] * want[j][j]).sqrt();
+                assert!((c - want[i][j]).abs() < 0.05 * scale, "({i}, {j}): {c} against {}", want[i][j]);
+            }
+        }
+        let count = |law: &RestitutionLaw| {
+            let mut k = 0;
+            law.sample_with(|| {
+                k += 1;
+                0.0
+            });
+            k
+        };
+        assert_eq!((count(&law()), count(&l)), (4, 6));
+    }
+
+    /// The energy term reads back from JSON, and a law that mixes it with the
+    /// wrong form, or whose `cov` is not its block, or whose 3×3 covariance is
+    /// not positive semi-definite, is refused.
+    #[test]
+    fn energy_json_round_trip_and_bad_input() {
+        let l = energy_law();
+        let s = serde_json::to_string(&l).unwrap();
+        assert!(s.contains("\"form\":\"speed-and-energy-loss\"") && s.contains("\"energy\":"), "{s}");
+        assert_eq!(serde_json::from_str::<RestitutionLaw>(&s).unwrap(), l);
+        let wrong_form = s.replace("speed-and-energy-loss", "speed-loss");
+        assert!(serde_json::from_str::<RestitutionLaw>(&wrong_form)
+            .unwrap_err()
+            .to_string()
+            .contains("energy"));
+        let mut v: serde_json::Value = serde_json::from_str(&s).unwrap();
+        v["parameters"]["in"]["cov"] = serde_json::json!([[2e-4, 1e-5], [1e-5, 4e-6]]);
+        v["parameters"]["out"] = v["parameters"]["in"].clone();
+        let err = serde_json::from_value::<RestitutionLaw>(v).unwrap_err().to_string();
+        assert!(err.contains("block"), "{err}");
+        let mut v: serde_json::Value = serde_json::from_str(&s).unwrap();
+        v["parameters"]["in"]["energy"]["cov"] = serde_json::json!([[1e-4, 1e-5, 1e-3], [1e-5, 4e-6, 0.0], [1e-3, 0.0, 1e-7]]);
+        v["parameters"]["out"] = v["parameters"]["in"].clone();
+        let err = serde_json::from_value::<RestitutionLaw>(v).unwrap_err().to_string();
+        assert!(err.contains("positive semi-definite"), "{err}");
     }
 }

@@ -200,6 +200,7 @@ fn law_test(
         c,
         cov: [[0.0; 2]; 2],
         g: Default::default(),
+        energy: None,
     };
     let model = RockingModel {
         alpha,

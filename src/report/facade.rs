@@ -487,7 +487,7 @@ fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64) -> String {
     use crate::wall::Side;
     let (lo, hi) = (law.parameters.amplitude_min, law.parameters.amplitude_max);
     let mut parts = Vec::new();
-    if law.form == LawForm::SpeedLoss {
+    if law.form != LawForm::Constant {
         parts.push(format!("the campaign's impacts span a = |θ|/α = {lo:.3}–{hi:.3}"));
     }
     for (side, name) in [(Side::Inward, "inward"), (Side::Outward, "outward")] {

@@ -136,19 +136,33 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
     };
     let p = &fit.law.parameters;
     let side = |name: &str, l: &crate::restitution_law::SideLaw| {
+        let g = match l.g {
+            crate::restitution_law::Shape::Free => "√(a(2 − a))",
+            crate::restitution_law::Shape::Push => "a",
+        };
         // A rise (c < 0) reads "+ |c|", not "− -c".
-        format!(
-            "{name}: r(a) = {:.4} (± {:.4}) {} {:.5} (± {:.5}) / {}",
+        let mut t = format!(
+            "{name}: r(a) = {:.4} (± {:.4}) {} {:.5} (± {:.5}) / {g}",
             l.r_inf,
             l.cov[0][0].sqrt(),
             if l.c < 0.0 { "+" } else { "−" },
             l.c.abs(),
             l.cov[1][1].sqrt(),
-            match l.g {
-                crate::restitution_law::Shape::Free => "√(a(2 − a))",
-                crate::restitution_law::Shape::Push => "a",
-            }
-        )
+        );
+        if let Some(e) = &l.energy {
+            let g2 = match l.g {
+                crate::restitution_law::Shape::Free => "(a(2 − a))",
+                crate::restitution_law::Shape::Push => "a²",
+            };
+            t.push_str(&format!(
+                " − {:.3e} (± {:.1e}) / {g2} (its tangent outside a = {:.4}–{:.3})",
+                e.c2,
+                e.cov[2][2].max(0.0).sqrt(),
+                l.g.eval_inverse(e.g_hi),
+                l.g.eval_inverse(e.g_lo)
+            ));
+        }
+        t
     };
     let text = if p.shared {
         side("both sides", &p.inward)
@@ -156,10 +170,15 @@ pub fn law_section(res: &CampaignResult, figure: Option<&Figure>) -> String {
         format!("{}; {}", side("in", &p.inward), side("out", &p.outward))
     };
     s.push_str(&format!(
-        "<p>Form {}: r = r∞ − c/√(a(2 − a)), a fixed loss of angular speed per impact on top of a proportional one{} (docs/restitution-law.md). {}. Fitted to the impacts of {} (status ok, in the means), amplitudes {:.3}–{:.3}.</p>\n",
+        "<p>Form {}: r = r∞ − c/√(a(2 − a)), a fixed loss of angular speed per impact on top of a proportional one{}{} (docs/restitution-law.md). {}. Fitted to the impacts of {} (status ok, in the means), amplitudes {:.3}–{:.3}.</p>\n",
         fit.law.form.as_str(),
         if p.outward.g == crate::restitution_law::Shape::Push {
             "; the outward side of a one-sided wall r = r∞ − c/a (its impacts end a push against the transverse walls, speed ∝ amplitude)"
+        } else {
+            ""
+        },
+        if fit.law.form == crate::restitution_law::LawForm::SpeedAndEnergyLoss {
+            "; where Akaike's criterion prefers it, a fixed loss of energy per impact besides, − c₂ g² (the loss grows faster as the amplitude falls)"
         } else {
             ""
         },

@@ -339,7 +339,7 @@ fn cholesky3(s: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     l
 }
 
-/// Whether L Lᵀ (the Cholesky factor of `s`) gives back `s` to a relative 1e-9:
+/// Whether L Lᵀ (the Cholesky factor of `s`) gives back `s` to 1e-6 of its trace:
 /// a negative pivot, clamped to 0, does not.
 fn positive_semi_definite3(s: &[[f64; 3]; 3]) -> bool {
     let l = cholesky3(s);
@@ -579,7 +579,9 @@ impl RestitutionLaw {
 
     /// Checks what deserialisation cannot: finite parameters in range, a symmetric
     /// positive semi-definite covariance, 0 < amplitude_min ≤ amplitude_max ≤ 1, c = 0
-    /// for a constant, in == out for a shared law.
+    /// for a constant, in == out for a shared law, an energy term exactly where the
+    /// form is "speed-and-energy-loss" (with its own checks: finite, 1 ≤ g_lo ≤ g_hi,
+    /// a symmetric positive semi-definite 3×3 covariance whose block is `cov`).
     pub fn validate(&self) -> Result<(), String> {
         let p = &self.parameters;
         p.inward.validate("restitution law, side \"in\"")?;

@@ -956,6 +956,28 @@ fn facade_law_set() {
     let study = write_study(dir.path(), &with_set("law = \"summary.json\"\ne_h = 0.98\nspread = \"none\""));
     let o = facade(&study, &dir.path().join("o2"), &[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A law with the energy term (thirty-seventh session) runs and says its form;
+    // one whose `cov` is not the block of its 3×3 covariance is refused.
+    let mut energy: Value = serde_json::from_str(&law_text).unwrap();
+    for side in ["in", "out"] {
+        let p = &mut energy["parameters"][side];
+        let c = p["cov"].clone();
+        let cov3 = serde_json::json!([[c[0][0], c[0][1], 0.0], [c[1][0], c[1][1], 0.0], [0.0, 0.0, 1e-10]]);
+        p["energy"] = serde_json::json!({"c2": 1e-4, "cov": cov3, "g_lo": 1.2, "g_hi": 40.0});
+    }
+    energy["form"] = "speed-and-energy-loss".into();
+    std::fs::write(dir.path().join("energy.json"), energy.to_string()).unwrap();
+    let study = write_study(dir.path(), &with_set("law = \"energy.json\""));
+    let o = facade(&study, &dir.path().join("o4"), &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(dir.path().join("o4/results.md")).unwrap();
+    assert!(md.contains("(speed-and-energy-loss)"), "{md}");
+    energy["parameters"]["in"]["energy"]["cov"][0][0] = 1.0.into();
+    std::fs::write(dir.path().join("energy-bad.json"), energy.to_string()).unwrap();
+    let study = write_study(dir.path(), &with_set("law = \"energy-bad.json\""));
+    let o = facade(&study, &dir.path().join("o5"), &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("upper-left block"), "{err}");
     std::fs::write(dir.path().join("bad.json"), "{\n  \"form\": \"speed-loss\",\n  \"parameters\": 3\n}\n").unwrap();
     std::fs::write(dir.path().join("none.json"), "{\"campaign\": \"x\"}").unwrap();
     // Session 13: a reduction that fitted no law (fresh-one-default: too few inward

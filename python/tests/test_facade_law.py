@@ -69,3 +69,35 @@ def test_facade_ensembles_equal_cli(cli, tmp_path):
     assert len(res.rows) == 3 * 2 * 3 and len(res.samples) == 3 * 2 * 3 * 4
     law_samples = res.samples[res.samples["coefficients"] == "law"]
     assert law_samples["e_out"].nunique() > 1, "the law's parameters are drawn per sample"
+
+
+def test_an_energy_term_of_zero_is_the_speed_loss_law_bit_for_bit():
+    """Thirty-seventh session: a law whose sides carry the energy term
+    (form "speed-and-energy-loss") runs from Python; with c2 = 0 and no spread it
+    gives the speed-loss law's history bit for bit, and with c2 > 0 the history
+    changes (the term is read, not dropped; its values are checked in Rust,
+    tests/solver.rs)."""
+    base = json.loads(LAW.read_text())
+
+    def with_energy(c2):
+        law = json.loads(json.dumps(base))
+        law["form"] = "speed-and-energy-loss"
+        for side in ("in", "out"):
+            p = law["parameters"][side]
+            c = p["cov"]
+            p["energy"] = {
+                "c2": c2,
+                "cov": [[c[0][0], c[0][1], 0.0], [c[1][0], c[1][1], 0.0], [0.0, 0.0, 0.0]],
+                "g_lo": 1.05,
+                "g_hi": 30.0,
+            }
+        return law
+
+    plain = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=base)
+    zero = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=with_energy(0.0))
+    assert plain["impacts"] > 5
+    for k in ("t_s", "theta_rad", "theta_dot_rad_s"):
+        np.testing.assert_array_equal(zero.history[k], plain.history[k])
+    assert zero["law"]["law"]["form"] == "speed-and-energy-loss"
+    lossy = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=with_energy(1e-3))
+    assert not np.array_equal(lossy.history["theta_rad"], plain.history["theta_rad"])

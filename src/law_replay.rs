@@ -508,7 +508,7 @@ fn law_ends(r_inf: f64, c: f64, span: (f64, f64)) -> String {
     if r(span.0) > 0.0 || r_inf <= 0.0 || c <= 0.0 {
         return format!("r = {:.3} at a = {:.3}, {top}", r(span.0).max(0.0), span.0);
     }
-    let a0 = 1.0 - (1.0 - (c / r_inf).powi(2)).max(0.0).sqrt();
+    let a0 = Shape::Free.eval_inverse(r_inf / c);
     format!("{top}; it falls to 0 at a = {a0:.4}, inside the span: below that the law stops the wall")
 }
 

@@ -210,13 +210,13 @@ impl SideLaw {
 
     /// r∞ − c g − c₂ q(g), not clamped.
     fn value(&self, g: f64) -> f64 {
-        let energy = self.energy.map_or(0.0, |e| e.c2 * e.q(g));
+        let energy = self.energy.as_ref().map_or(0.0, |e| e.c2 * e.q(g));
         self.r_inf - self.c * g - energy
     }
 
     /// dr/dg at g (the side's r falls as the amplitude falls where it is negative).
     fn slope(&self, g: f64) -> f64 {
-        let energy = self.energy.map_or(0.0, |e| 2.0 * e.c2 * g.clamp(e.g_lo, e.g_hi));
+        let energy = self.energy.as_ref().map_or(0.0, |e| 2.0 * e.c2 * g.clamp(e.g_lo, e.g_hi));
         -self.c - energy
     }
 

@@ -9,7 +9,7 @@
 //! | [`energy_gain`] | a peak is faster than the one before by more than 2 % + 3 u (free rocking only loses energy) |
 //! | [`impact_gains_speed`] | the speed after an impact exceeds the speed before it by more than 3 u (e > 1) |
 //! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise |
-//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`); not on a one-sided fit with contact phases and no filter where they stand out around exit impacts only (`peaks::exits_only_misfit`) |
+//! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`); not on a one-sided fit with contact phases and no filter where they stand out around exit impacts only (`peaks::exits_only_misfit`), nor where the contact model reads every peak that ends at one of the impacts where they stand out (`inward.rs`, "Residuals that stand out") |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |
 //! | [`zero_readings_disagree`] | a peak's readings up to the fitted zero and up to the rest line differ by more than 20 %; on a one-sided push (k odd, contact phases, no filter) only where the contact model does not read the pushes (`inward.rs`) |

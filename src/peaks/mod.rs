@@ -299,6 +299,22 @@ pub struct Analysis {
     /// peak). [`analyse`] adds it to `quality` unless the contact model reads
     /// the pushes ([`inward`]); it is `None` once [`analyse`] returns.
     pub deferred_reason: Option<String>,
+    /// Residuals that stand out around impacts of a one-sided log with
+    /// contact phases and no filter ([`checks::structured_near_impacts`]),
+    /// which are a reason only while a peak read at one of those impacts keeps
+    /// the global fit's reading: [`analyse`] adds the reason to `quality`
+    /// unless the contact model reads every such peak ([`inward::reads_past`]);
+    /// `None` once [`analyse`] returns.
+    pub deferred_misfit: Option<DeferredMisfit>,
+}
+
+/// Residuals that stand out around impacts, deferred ([`Analysis::deferred_misfit`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeferredMisfit {
+    /// The reason in words ([`checks::structured_near_impacts`]).
+    pub reason: String,
+    /// Every impact whose residuals stand out ([`checks::structured_impacts`]).
+    pub impacts: Vec<usize>,
 }
 
 pub use local::ReadingMethod;
@@ -427,12 +443,39 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
             if !replaced {
                 a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(deferred);
             }
+            if let Some(m) = a.deferred_misfit.take() {
+                if inward::reads_past(&a, &m.impacts) {
+                    a.model_note = Some(read_past_note(a.model_note.take(), &m));
+                } else {
+                    a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(Some(m.reason));
+                }
+            }
             if phys.rocking == crate::wall::Rocking::OneSided {
                 let unresolved = unresolved_inward_arcs(&a, dt, opts);
                 a.quality = std::mem::replace(&mut a.quality, Quality::Ok).with(unresolved);
             }
             a
         }),
+    }
+}
+
+/// The model note of an analysis whose residuals stand out around impacts
+/// whose peaks the contact model reads ([`inward::reads_past`]), after the
+/// note it had.
+fn read_past_note(before: Option<String>, m: &DeferredMisfit) -> String {
+    let at: Vec<String> = m.impacts.iter().map(|k| k.to_string()).collect();
+    let (noun, those) = if at.len() == 1 {
+        ("impact", "the peak that ends there is")
+    } else {
+        ("impacts", "the peaks that end there are")
+    };
+    let note = format!(
+        "the global fit's residuals stand out around {noun} {} (more than 8 × the noise): its contact there is not the wall's, so {those} read by the contact model, the two readings' disagreement in the u",
+        at.join(", ")
+    );
+    match before {
+        Some(b) => format!("{b}; {note}"),
+        None => note,
     }
 }
 
@@ -566,6 +609,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         local_misfit: Vec::new(),
         model_note: None,
         deferred_reason: None,
+        deferred_misfit: None,
     }
 }
 
@@ -877,6 +921,14 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     } else {
         (spread.clone(), None)
     };
+    // Residuals that stand out around impacts of such a log are a reason only
+    // where the contact model does not read the peaks there (`inward`, after
+    // this fit): deferred, with the impacts.
+    let deferred_misfit = if pushes_rereadable && !exits_misfit {
+        deferred_structured(&fit, &resid, &methods, p.dt, p.sigma)
+    } else {
+        None
+    };
     let verdict = quality::plausibility(
         &fit,
         &resid,
@@ -885,7 +937,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         &spread_checked,
         &methods,
         (p.dt, p.sigma),
-        exits_misfit,
+        exits_misfit || deferred_misfit.is_some(),
         &late,
     );
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
@@ -931,5 +983,28 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         local_misfit,
         model_note: model_note.or_else(|| fit.leaning.as_ref().map(|_| LEANING_NOTE.to_string())),
         deferred_reason,
+        deferred_misfit,
     })
+}
+
+/// [`checks::structured_near_impacts`] on the global fit, its onsets those of
+/// the peaks it reads (`methods`, as [`quality::plausibility`] checks them),
+/// with every impact whose residuals stand out.
+fn deferred_structured(fit: &SegmentFit, resid: &[f64], methods: &[ReadingMethod], dt: f64, sigma: f64) -> Option<DeferredMisfit> {
+    let m = fit.model();
+    let onsets: Vec<f64> = (0..m.m())
+        .map(|k| {
+            if methods.get(k) == Some(&ReadingMethod::LocalExtreme) {
+                f64::NAN
+            } else {
+                m.onset(k)
+            }
+        })
+        .collect();
+    let reason = checks::structured_near_impacts(&fit.tw, resid, &onsets, dt, sigma)?;
+    let impacts = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma)
+        .into_iter()
+        .map(|(k, _)| k)
+        .collect();
+    Some(DeferredMisfit { reason, impacts })
 }

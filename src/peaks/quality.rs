@@ -41,8 +41,10 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
 ///
 /// Residuals that stand out around an impact are a reason only where the
 /// local readings of the peaks (`late`, computed only then) do not vouch for
-/// the global fit's ([`vouch`]), and not where they stand out around a
-/// one-sided wall's exits only (`exits_misfit`, `super::exits_only_misfit`).
+/// the global fit's ([`vouch`]); not checked here (`structured_elsewhere`)
+/// where they stand out around a one-sided wall's exits only
+/// (`super::exits_only_misfit`) or where the caller defers them
+/// ([`super::Analysis::deferred_misfit`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn plausibility(
     fit: &SegmentFit,
@@ -52,7 +54,7 @@ pub(super) fn plausibility(
     spread: &[f64],
     methods: &[ReadingMethod],
     (dt, sigma): (f64, f64),
-    exits_misfit: bool,
+    structured_elsewhere: bool,
     late: &dyn Fn() -> Vec<LatePeak>,
 ) -> Quality {
     let is_local = |k: usize| methods.get(k) == Some(&ReadingMethod::LocalExtreme);
@@ -77,7 +79,7 @@ pub(super) fn plausibility(
         checks::energy_gain(&v, &u),
         checks::impact_gains_speed(&v, &after, &u),
         checks::misfit(resid, sigma),
-        if exits_misfit {
+        if structured_elsewhere {
             None
         } else {
             structured_unvouched(fit, resid, &onsets, peaks, dt, sigma, late)

@@ -111,12 +111,18 @@ pub fn robust_spread(r: &[f64]) -> f64 {
 /// there does not trip it; a misplaced impact moves them all). The reason
 /// names the first such impact ([`structured_impacts`]).
 pub fn structured_near_impacts(t: &[f64], residuals: &[f64], impacts: &[f64], dt: f64, sigma: f64) -> Option<String> {
-    structured_impacts(t, residuals, impacts, dt, sigma).first().map(|&(k, r)| {
-        format!(
-            "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
-            r / sigma
-        )
-    })
+    structured_impacts(t, residuals, impacts, dt, sigma)
+        .first()
+        .map(|&(k, r)| standing_out(k, r, sigma))
+}
+
+/// The reason of [`structured_near_impacts`] for impact k, whose residuals
+/// spread `r` mm.
+pub fn standing_out(k: usize, r: f64, sigma: f64) -> String {
+    format!(
+        "the residuals around impact {k} stand out (spread {r:.3} mm, {:.1} × the noise): the impact is not where the fit puts it",
+        r / sigma
+    )
 }
 
 /// Every impact k whose residuals stand out (at least 3 samples within ±2

@@ -491,11 +491,6 @@ mod tests {
         }
     }
 
-    /// A late landing (peak 4) whose global fit's residuals stand out
-    /// (`local_misfit` ≥ [`LANDING_STANDS_OUT`]) takes its contact reading where
-    /// that fits the samples to the noise, u the larger of the global u and the
-    /// readings' disagreement; not where the residuals do not stand out, not at
-    /// peak 2, not where the reading misses the noise.
     #[test]
     fn a_misfit_is_read_past_only_where_the_contact_model_reads_every_peak_that_ends_there() {
         let mut a = analysis(&[-100.0, 60.0, -50.0, 30.0, -25.0, 15.0], 1.0);
@@ -510,6 +505,11 @@ mod tests {
         assert!(!reads_past(&a, &[3]));
     }
 
+    /// A late landing (peak 4) whose global fit's residuals stand out
+    /// (`local_misfit` ≥ [`LANDING_STANDS_OUT`]) takes its contact reading where
+    /// that fits the samples to the noise, u the larger of the global u and the
+    /// readings' disagreement; not where the residuals do not stand out, not at
+    /// peak 2, not where the reading misses the noise.
     #[test]
     fn a_late_landing_the_global_fit_misses_is_read_by_the_contact_model() {
         let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];

@@ -1001,10 +1001,10 @@ fn deferred_structured(fit: &SegmentFit, resid: &[f64], methods: &[ReadingMethod
             }
         })
         .collect();
-    let reason = checks::structured_near_impacts(&fit.tw, resid, &onsets, dt, sigma)?;
-    let impacts = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma)
-        .into_iter()
-        .map(|(k, _)| k)
-        .collect();
-    Some(DeferredMisfit { reason, impacts })
+    let standing = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
+    let &(first, spread) = standing.first()?;
+    Some(DeferredMisfit {
+        reason: checks::standing_out(first, spread, sigma),
+        impacts: standing.iter().map(|&(k, _)| k).collect(),
+    })
 }

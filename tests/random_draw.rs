@@ -5,12 +5,18 @@
 //!
 //! `cargo test` runs a small draw; the full draw of the issue (500 rigid tests,
 //! 200 compliant) is `cargo test --release --test random_draw -- --ignored --nocapture`.
+//!
+//! The full draws' seeds are fixed, and earlier sessions mended what those
+//! seeds showed (the `…_once_…` tests below), so they are no hold-out any more.
+//! `DRAW_SEED_OFFSET=N` shifts every full draw's seeds by N: draws no session
+//! has looked at, the same families and ranges (docs/accuracy.md, "Fresh
+//! seeds").
 
 use rayon::prelude::*;
 use rocklab::synth::{draw, score, Family, Scored};
 
 fn run(family: Family, seeds: std::ops::Range<u64>) -> Vec<Scored> {
-    seeds.into_par_iter().map(|s| score(&draw(s, family))).collect()
+    fresh(seeds).into_par_iter().map(|s| score(&draw(s, family))).collect()
 }
 
 /// Print the failures and the summary; return (success rate, silent failures).
@@ -135,7 +141,16 @@ use rocklab::synth::{draw_logged, score_with, LoggerDraw};
 /// Logged draws: each test through a random filter of `kind`, reduced with the
 /// filter stated in the options or not.
 fn run_logged(seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) -> Vec<Scored> {
-    run_logged_seeds(&seeds.collect::<Vec<_>>(), kind, stated)
+    run_logged_seeds(&fresh(seeds).collect::<Vec<_>>(), kind, stated)
+}
+
+/// `seeds` shifted by `DRAW_SEED_OFFSET` (module docs; 0 when unset).
+fn fresh(seeds: std::ops::Range<u64>) -> std::ops::Range<u64> {
+    let offset: u64 = match std::env::var("DRAW_SEED_OFFSET") {
+        Ok(v) => v.parse().unwrap_or_else(|_| panic!("DRAW_SEED_OFFSET={v:?} is not a whole number")),
+        Err(_) => 0,
+    };
+    seeds.start + offset..seeds.end + offset
 }
 
 /// [`run_logged`] over the draws `seeds`.
@@ -304,6 +319,17 @@ fn stated_filter_tests_once_started_late_are_reduced() {
 #[test]
 fn unstated_tests_once_flagged_for_an_equal_contact_fit_are_reduced() {
     each_ok_within_1pp(&run_logged_seeds(&[3060, 3069, 3118, 3198], bessel(0.25, 0.40), false));
+}
+
+/// Unstated-causal draws of the fresh seeds (`DRAW_SEED_OFFSET=100000`,
+/// thirty-ninth session) that were ok but 2.28 and 1.21 pp off: 106008 and
+/// 106132, each through a Butterworth 2 (0.249 and 0.187 f_s, 100 Hz) that no
+/// fourth-order response fits to the noise; 106008's contact phases read its
+/// landings 3–13 % low. Each is ok and within 1 pp through an estimated
+/// Butterworth 2 (`acquisition::Generic::Butterworth2`).
+#[test]
+fn fresh_draws_through_a_second_order_filter_are_reduced() {
+    each_ok_within_1pp(&run_logged_seeds(&[106008, 106132], all_causal(), false));
 }
 
 /// Every test of `scored` has status ok and is within 1 pp of its truth.

@@ -8,9 +8,10 @@
 //!
 //! The full draws' seeds are fixed, and earlier sessions mended what those
 //! seeds showed (the `…_once_…` tests below), so they are no hold-out any more.
-//! `DRAW_SEED_OFFSET=N` shifts every full draw's seeds by N: draws no session
-//! has looked at, the same families and ranges (docs/accuracy.md, "Fresh
-//! seeds").
+//! `DRAW_SEED_OFFSET=N` shifts the seeds of every draw taken by range (the
+//! full draws and the small ones; not the listed draws of the `…_once_…`
+//! tests) by N: draws no session has looked at, the same families and ranges
+//! (docs/accuracy.md, "Fresh seeds").
 
 use rayon::prelude::*;
 use rocklab::synth::{draw, score, Family, Scored};

@@ -791,11 +791,10 @@ pub fn rival(rivals: &Rivals, tw: &[f64], yw: &[f64], dt: f64, sigma: f64) -> Re
     Ok((est, spread))
 }
 
-/// Whether a fit's cost is at the noise: χ²/σ² ≤ ν + 3√(2ν), ν = n − its free
-/// parameters.
+/// Whether a fit's cost is at the noise ([`super::checks::at_noise`]),
+/// ν = n − its free parameters.
 fn at_noise(f: &Fitted, n: f64, sigma2: f64) -> bool {
-    let nu = (n - f.free.len() as f64).max(1.0);
-    f.fit.cost / sigma2 <= nu + 3.0 * (2.0 * nu).sqrt()
+    super::checks::at_noise(f.fit.cost / sigma2, (n - f.free.len() as f64).max(1.0))
 }
 
 /// An unstated causal low-pass estimated below this fraction of the sampling

@@ -83,6 +83,13 @@ pub fn impact_gains_speed(before: &[f64], after: &[Option<f64>], u: &[f64]) -> O
     })
 }
 
+/// Whether a fit's χ² (in units of σ²) is at the noise: within the 3-σ upper
+/// end of χ²_ν, whose mean is ν and standard deviation √(2ν):
+/// χ² ≤ ν + 3√(2ν).
+pub fn at_noise(chi2: f64, nu: f64) -> bool {
+    chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+}
+
 /// The model must fit the log to the noise level. The spread of the residuals is
 /// measured robustly, 1.4826 × median |r| (σ for Gaussian noise), so that a
 /// spike the cleaner left does not condemn a good fit; a wrong model moves most

@@ -150,8 +150,7 @@ impl KinkFit {
         Some(KinkFit { c, inv, chi2, n, h, s_k })
     }
     fn fits_noise(&self) -> bool {
-        let nu = (self.n - KINK_COLUMNS) as f64;
-        self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+        super::checks::at_noise(self.chi2, (self.n - KINK_COLUMNS) as f64)
     }
     /// Gradient of y'(s_k⁻) in c, per unit time.
     fn d(&self) -> DVector<f64> {
@@ -394,7 +393,7 @@ impl ContactReading {
     /// Whether the model fits the samples to the noise: χ² ≤ ν + 3√(2ν).
     pub fn fits_noise(&self) -> bool {
         let nu = self.dof();
-        nu > 0.0 && self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+        nu > 0.0 && super::checks::at_noise(self.chi2, nu)
     }
 
     /// ν = n − params, the fit's degrees of freedom.
@@ -1124,7 +1123,7 @@ pub fn centre_of(t: &[f64], y: &[f64], halves: &[(f64, f64)], post_s: f64, sigma
     };
     let params = at_zero.free_count() + 2;
     let nu: f64 = windows.iter().map(|(tau, _)| tau.len().saturating_sub(params) as f64).sum();
-    if score(arc.1) <= nu + 3.0 * (2.0 * nu).sqrt() {
+    if super::checks::at_noise(score(arc.1), nu) {
         return arc.1;
     }
     const GRID: usize = 41;

@@ -198,8 +198,7 @@ impl LocalFit {
     }
     /// χ² within the 3-σ upper end of χ²_ν.
     fn fits_noise(&self) -> bool {
-        let nu = (self.n - self.shape.columns()) as f64;
-        self.chi2 <= nu + 3.0 * (2.0 * nu).sqrt()
+        super::checks::at_noise(self.chi2, (self.n - self.shape.columns()) as f64)
     }
     /// The gradient of y'(s) in c, per unit time.
     fn d(&self, s: f64) -> DVector<f64> {

@@ -991,16 +991,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
 /// the peaks it reads (`methods`, as [`quality::plausibility`] checks them),
 /// with every impact whose residuals stand out.
 fn deferred_structured(fit: &SegmentFit, resid: &[f64], methods: &[ReadingMethod], dt: f64, sigma: f64) -> Option<DeferredMisfit> {
-    let m = fit.model();
-    let onsets: Vec<f64> = (0..m.m())
-        .map(|k| {
-            if methods.get(k) == Some(&ReadingMethod::LocalExtreme) {
-                f64::NAN
-            } else {
-                m.onset(k)
-            }
-        })
-        .collect();
+    let onsets = quality::checked_onsets(fit.model(), methods);
     let standing = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
     let &(first, spread) = standing.first()?;
     Some(DeferredMisfit {

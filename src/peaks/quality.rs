@@ -68,7 +68,7 @@ pub(super) fn plausibility(
     // The local re-fit estimates the free arc's slope at the onset of contact.
     let v_onset: Vec<f64> = (0..v.len()).map(|k| m.speeds(k).0).collect();
     let zeros: Vec<f64> = (0..m.m()).map(|k| m.impact(k)).collect();
-    let onsets: Vec<f64> = (0..m.m()).map(|k| if is_local(k) { f64::NAN } else { m.onset(k) }).collect();
+    let onsets = checked_onsets(m, methods);
     // Impacts 0..n−1: the ones that end the peaks the tables use, the last
     // one's included (it ends peak n−1: an exit that gains speed there has
     // that peak's time wrong, docs/estimator.md).
@@ -108,6 +108,21 @@ pub(super) fn plausibility(
     } else {
         Quality::Suspect(reasons)
     }
+}
+
+/// The onset of every impact of `m` whose residuals the checks read: NaN where
+/// the peak that ends there is a local extreme's (`methods`), not the global
+/// fit's.
+pub(super) fn checked_onsets(m: &super::model::Model, methods: &[ReadingMethod]) -> Vec<f64> {
+    (0..m.m())
+        .map(|k| {
+            if methods.get(k) == Some(&ReadingMethod::LocalExtreme) {
+                f64::NAN
+            } else {
+                m.onset(k)
+            }
+        })
+        .collect()
 }
 
 /// [`checks::structured_near_impacts`], unless the local readings vouch for the

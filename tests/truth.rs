@@ -330,19 +330,26 @@ fn an_unsettled_push_flags_a_test_only_while_the_global_fit_reads_it() {
 /// reads say nothing of that peak (`src/peaks/inward.rs`, "Residuals that
 /// stand out"). `mujoco-one-sided-misfit-read-past`: H1_140_2 of the
 /// one-sided hold-out preset, seed 3623 (200 Hz). The global fit's residuals
-/// stand out around impacts 4 (9.3 × the noise) and 5; until the thirty-eighth
+/// stood out around impacts 4 (9.3 × the noise) and 5; until the thirty-eighth
 /// session that flagged it, its values within 0.88 pp of the truth (peak 4
 /// +3.7 % by the global fit). Its pushes (peak 5 among them) and its late
-/// landing, peak 4, are now read by the contact model: ok, the note says why, every value within
-/// 1 pp (measured 0.59 pp) and 2 u.
+/// landing, peak 4, were then read by the contact model. Since the fortieth
+/// session the inward arcs' gravity term is linearised about a point of the
+/// arc (`model::Model::inward_arc`): the residuals around impact 4 no longer
+/// stand out (1.9 × their spread), peak 4 is the global fit's again, and
+/// they stand out at the exit alone (impact 5, 9.3 ×), whose peak the
+/// contact model reads: ok, the note says why, every value within 1 pp
+/// (measured 0.54 pp, r₁) and 2 u.
 #[test]
 fn a_misfit_around_an_impact_the_contact_model_reads_is_no_reason() {
     let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-misfit-read-past");
     let r = res.tests[0].result.as_ref().unwrap();
-    assert!(r.analysis.contact_model_peaks().contains(&4));
     assert!(r.analysis.deferred_misfit.is_none());
     let note = r.analysis.model_note.as_deref().unwrap_or("");
-    assert!(note.contains("residuals stand out around impacts 4, 5"), "{note}");
+    assert!(
+        note.contains("residuals stand out where the wall leaves the transverse walls (impact 5"),
+        "{note}"
+    );
     assert_values_within(r, &truth, "H1_140_2", 0.01);
 }
 

@@ -244,6 +244,25 @@ impl InwardArc {
         }
     }
 
+    /// The arc's depth max |y| (mm): the zero of y' between the entry (y' < 0)
+    /// and the exit (y' > 0), by bisection to 2⁻⁴⁰ T. Near the apex y'' > 0
+    /// (the restraint and gravity both push outward), so y' has one zero.
+    pub fn depth(&self) -> f64 {
+        let (mut a, mut b) = (0.0, self.t_len);
+        if !(self.at(a).1 < 0.0 && self.at(b).1 > 0.0) {
+            return (0..=64).map(|i| -self.at(self.t_len * i as f64 / 64.0).0).fold(0.0, f64::max);
+        }
+        for _ in 0..40 {
+            let m = 0.5 * (a + b);
+            if self.at(m).1 < 0.0 {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        -self.at(0.5 * (a + b)).0
+    }
+
     /// The separation time t_s from the start of the arc, if the wall separates.
     pub fn separation_time(&self) -> Option<f64> {
         self.sep.map(|s| s.0)

@@ -49,6 +49,46 @@ pub fn jacobi(u: f64, kc: f64) -> (f64, f64, f64) {
     (sn, cn, (kc * kc + k2 * cn * cn).sqrt())
 }
 
+/// A bracket [a, b] of the root of an increasing function, f(a) ≤ 0 ≤ f(b),
+/// narrowed by the Illinois variant of regula falsi: the end a new point
+/// replaces moves, and where the same end moves twice in a row the other
+/// end's value is halved, so that the secant does not stall on one side.
+pub(crate) struct Illinois {
+    pub a: f64,
+    pub fa: f64,
+    pub b: f64,
+    pub fb: f64,
+    side: i8,
+}
+
+impl Illinois {
+    pub fn new((a, fa): (f64, f64), (b, fb): (f64, f64)) -> Illinois {
+        Illinois { a, fa, b, fb, side: 0 }
+    }
+
+    /// The zero of the secant through both ends.
+    pub fn secant(&self) -> f64 {
+        (self.a * self.fb - self.b * self.fa) / (self.fb - self.fa)
+    }
+
+    /// Replace the end on the side of f(x) by (x, f(x)).
+    pub fn narrow(&mut self, x: f64, fx: f64) {
+        if fx > 0.0 {
+            (self.b, self.fb) = (x, fx);
+            if self.side == 1 {
+                self.fa *= 0.5;
+            }
+            self.side = 1;
+        } else {
+            (self.a, self.fa) = (x, fx);
+            if self.side == -1 {
+                self.fb *= 0.5;
+            }
+            self.side = -1;
+        }
+    }
+}
+
 /// Chebyshev nodes of the correction ([`GravityArc`]).
 const NODES: usize = 8;
 
@@ -168,31 +208,19 @@ impl GravityArc {
         if !(fa <= 0.0 && fb >= 0.0) {
             return None;
         }
-        let mut side = 0i8;
+        let mut br = Illinois::new((a, fa), (b, fb));
         for _ in 0..100 {
-            if b - a < 1e-14 * alpha {
+            if br.b - br.a < 1e-14 * alpha {
                 break;
             }
-            let x = if fb > fa { (a * fb - b * fa) / (fb - fa) } else { 0.5 * (a + b) };
+            let x = if br.fb > br.fa { br.secant() } else { 0.5 * (br.a + br.b) };
             let fx = end(x);
             if fx == 0.0 {
                 return Some(x);
             }
-            if fx > 0.0 {
-                (b, fb) = (x, fx);
-                if side == 1 {
-                    fa *= 0.5;
-                }
-                side = 1;
-            } else {
-                (a, fa) = (x, fx);
-                if side == -1 {
-                    fb *= 0.5;
-                }
-                side = -1;
-            }
+            br.narrow(x, fx);
         }
-        Some(0.5 * (a + b))
+        Some(0.5 * (br.a + br.b))
     }
 
     /// The linearised arc θ_l and θ_l′ at τ.

@@ -24,6 +24,8 @@
 //! cost thousands and be neither smooth in the parameters (which the
 //! Levenberg–Marquardt Jacobian needs) nor exact.
 
+use super::gravity::Illinois;
+
 /// φ₂, φ₂' and ψ of the linear arc at τ (see [`InwardArc::linear`]), with ψ by its
 /// series where |λ| T² is small (T = `t_len`).
 fn parts(lambda: f64, gamma: f64, t_len: f64, x: f64) -> (f64, f64, f64) {
@@ -191,31 +193,18 @@ impl InwardArc {
             Try::Long => (t_len, None),
             Try::Arc(v0, ys, vs, len) => (len - t_len, Some((ts, v0, ys, vs))),
         };
-        let (mut a, mut ga) = (0.0, -t_len);
-        let (mut b, mut gb) = (t_len, g(t_len).0);
+        let gb = g(t_len).0;
         if gb < 0.0 {
             return None;
         }
-        let mut side = 0i8;
+        let mut br = Illinois::new((0.0, -t_len), (t_len, gb));
         for _ in 0..200 {
-            let x = (a * gb - b * ga) / (gb - ga);
+            let x = br.secant();
             let (gx, arc) = g(x);
             if gx.abs() <= 1e-13 * t_len {
                 return arc;
             }
-            if gx > 0.0 {
-                (b, gb) = (x, gx);
-                if side == 1 {
-                    ga *= 0.5;
-                }
-                side = 1;
-            } else {
-                (a, ga) = (x, gx);
-                if side == -1 {
-                    gb *= 0.5;
-                }
-                side = -1;
-            }
+            br.narrow(x, gx);
         }
         None
     }

@@ -5,7 +5,8 @@
 //! Eq. 1 (no ground motion) that starts and ends at θ = 0: the exact one on a
 //! gravity side ([`super::gravity`]) and for a two-sided wall's release, the
 //! closed form of Eq. 1 linearised about a point of the arc on the inward side
-//! of one-sided rocking and for a one-sided wall's release. Two extensions make it hold on real walls (issue #9):
+//! of one-sided rocking and for a one-sided wall's release. Two extensions
+//! make it hold on real walls (issue #9):
 //! - **lossy inward arcs** (one-sided): the transverse walls are a
 //!   compression-only spring–dashpot (y = L θ, [`super::restraint`]): while they
 //!   bear, y'' = A p² − λ y − 2γ y', and where the dashpot would have to pull
@@ -434,9 +435,10 @@ impl Model {
     /// three draws (0.62–0.68 α, walls 2.9–3.8 m high) by 0.002–0.006 mm RMS,
     /// and through p₀ the fit bent the later arcs to it (random draw 1185:
     /// χ²/n 1.48 with exact later arcs, contact phases chosen). One-sided
-    /// walls keep the linearised release: on three one-sided MuJoCo fixtures
-    /// (`tests/truth.rs`) the exact one took their pushes' u from 1–2 % to
-    /// 6–13 % and flagged a test reduced alone for its exits' residuals, and
+    /// walls keep the linearised release: with the exact one, three one-sided
+    /// MuJoCo fixtures (`tests/truth.rs`) failed what they assert (one test's
+    /// pushes at ± 6–13 % instead of under 2 %, one reduced alone flagged for
+    /// its exits' residuals, one at 100 Hz flagged for another reason), and
     /// their outward arcs are small, so the release alone sets p there.
     fn exact_release(&self) -> Option<GravityArc> {
         if !self.lever.is_finite() || self.one_sided {

@@ -147,13 +147,13 @@ mod tests {
     fn spikes_on_a_curved_arc_are_found() {
         let apex = [-28.95, -30.37, -31.61, -32.65, -34.48, -34.24, -34.72, -35.07, -35.23, -35.16];
         let mut x = apex.to_vec();
-        assert_eq!(remove_isolated_spikes(&mut x, 0.106), 1);
+        assert_eq!(remove_isolated_spikes(&mut x, 12.0 * 0.0133), 1);
         assert_eq!(x[3], apex[3], "the neighbour is left alone");
         // The arc's value there (the fit's, in the logged frame): −33.565.
         assert!((x[4] - (-33.5275)).abs() < 1e-9, "{}", x[4]);
         let fall = [21.31, 21.59, 21.72, 21.61, 21.38, 21.35, 20.30, 19.48, 18.44, 17.25];
         let mut x = fall.to_vec();
-        assert_eq!(remove_isolated_spikes(&mut x, 0.106), 1);
+        assert_eq!(remove_isolated_spikes(&mut x, 12.0 * 0.0133), 1);
         // The fit's value there, in the logged frame: 20.95.
         assert!((x[5] - 20.93).abs() < 0.02, "{x:?}");
     }

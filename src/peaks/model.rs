@@ -398,16 +398,23 @@ impl Model {
     /// on the parameters only, so a sweep over the samples computes them once
     /// ([`Model::shapes`]).
     fn shape(&self, s: usize) -> Shape {
+        let release = self.exact_release();
+        self.shape_with(s, release, self.p_small_given(release.is_some()))
+    }
+
+    /// [`Model::shape`] with the exact release and p_s already known (one
+    /// model's arcs share them: [`Model::shapes`] computes them once).
+    fn shape_with(&self, s: usize, release: Option<GravityArc>, ps: f64) -> Shape {
         if s == 0 {
-            return self.exact_release().map_or(Shape::Release, Shape::ExactRelease);
+            return release.map_or(Shape::Release, Shape::ExactRelease);
         }
         let (ta, tb) = self.zeros(s);
         if s % 2 == 1 && self.one_sided {
-            Shape::Inward(self.inward_arc(tb - ta))
+            Shape::Inward(self.inward_arc_with(tb - ta, ps))
         } else {
             let half = 0.5 * (tb - ta);
-            let (a, p) = self.gravity_arc_params(half);
-            match self.exact_arc(half, a, p) {
+            let (a, p) = self.gravity_arc_params_with(half, ps);
+            match self.exact_arc(half, a, p, ps) {
                 Some(arc) => Shape::Exact(arc),
                 None => Shape::Gravity { a, p },
             }
@@ -415,15 +422,15 @@ impl Model {
     }
 
     /// The exact gravity arc of half-length `half` (s) for this model's α and
-    /// p (p² = p_s² / cos α), about its linearised arc (A_k, p_k of
+    /// p (p² = p_s² / cos α, p_s = `ps` as [`Model::p_small`] gives it), about its linearised arc (A_k, p_k of
     /// [`Model::gravity_arc_params`]); None where the lever is not known
     /// (infinite) or the arc has no length.
-    fn exact_arc(&self, half: f64, a: f64, p: f64) -> Option<GravityArc> {
+    fn exact_arc(&self, half: f64, a: f64, p: f64, ps: f64) -> Option<GravityArc> {
         if !self.lever.is_finite() {
             return None;
         }
         let alpha = self.alpha();
-        GravityArc::solve(alpha, self.p_small() / alpha.cos().sqrt(), half, (a / self.lever, p))
+        GravityArc::solve(alpha, ps / alpha.cos().sqrt(), half, (a / self.lever, p))
     }
 
     /// The release arc of a two-sided wall as the second half of an exact arc
@@ -451,9 +458,11 @@ impl Model {
         GravityArc::solve(alpha0, p0, half, (ak / self.lever, pk))
     }
 
-    /// [`Model::shape`] of every arc.
+    /// [`Model::shape`] of every arc, the exact release and p_s computed once.
     fn shapes(&self) -> Vec<Shape> {
-        (0..self.m()).map(|s| self.shape(s)).collect()
+        let release = self.exact_release();
+        let ps = self.p_small_given(release.is_some());
+        (0..self.m()).map(|s| self.shape_with(s, release, ps)).collect()
     }
 
     /// [`Model::arc`] with the arc's shape given.
@@ -509,12 +518,17 @@ impl Model {
     /// about θ* = β θ₀ ([`BETA_RELEASE`], θ₀ its height), p₀² = p² cos(α − θ*)
     /// and p_s² = p₀² cos α / cos(α − θ*).
     pub fn p_small(&self) -> f64 {
+        self.p_small_given(self.exact_release().is_some())
+    }
+
+    /// [`Model::p_small`] where whether the release is exact is known.
+    fn p_small_given(&self, exact_release: bool) -> f64 {
         let p0 = self.p();
         if !self.lever.is_finite() {
             return p0;
         }
         let alpha = self.alpha();
-        if self.exact_release().is_some() {
+        if exact_release {
             return p0 * alpha.cos().sqrt();
         }
         let (a0, tr, t0) = (self.q[ix::LN_A0].exp(), self.release_time(), self.impact(0));
@@ -533,7 +547,11 @@ impl Model {
     /// they are A = L tan α and p_s (the small-angle arcs). θ_m depends on A_k
     /// and p_k (θ_m = A_k (1 − 1/cosh(p_k T/2)) / L): three fixed-point steps.
     pub fn gravity_arc_params(&self, half: f64) -> (f64, f64) {
-        let p = self.p_small();
+        self.gravity_arc_params_with(half, self.p_small())
+    }
+
+    /// [`Model::gravity_arc_params`] with p_s given.
+    fn gravity_arc_params_with(&self, half: f64, p: f64) -> (f64, f64) {
         if !self.lever.is_finite() {
             return (self.q[ix::LN_A].exp(), p);
         }
@@ -557,7 +575,12 @@ impl Model {
     /// 0.787–0.814 (shape error 2·10⁻⁴ θ_m at most, against 6·10⁻³ with the
     /// small-angle F and p; a Python check, `docs/estimator.md`).
     pub fn inward_arc(&self, t_len: f64) -> InwardArc {
-        let (a, p, lambda, gamma) = (self.q[ix::LN_A].exp(), self.p_small(), self.q[ix::LAMBDA], self.q[ix::GAMMA]);
+        self.inward_arc_with(t_len, self.p_small())
+    }
+
+    /// [`Model::inward_arc`] with p_s given.
+    fn inward_arc_with(&self, t_len: f64, p: f64) -> InwardArc {
+        let (a, lambda, gamma) = (self.q[ix::LN_A].exp(), self.q[ix::LAMBDA], self.q[ix::GAMMA]);
         let mut arc = InwardArc::solve(lambda, gamma, a * p * p, p, t_len);
         if !self.lever.is_finite() {
             return arc;

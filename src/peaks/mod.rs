@@ -60,7 +60,8 @@
 //! with its own uncertainty ([`local`]); [`Analysis::resolved_peaks`] says
 //! which reading each peak got.
 //!
-//! Before the fit: isolated spikes are replaced, the line through the final rest
+//! Before the fit: isolated spikes are replaced (and left out of the global
+//! fit, which a neighbour's value would mislead beside an impact), the line through the final rest
 //! (its slope shared with the initial hold) is subtracted (the sensor's zero and a
 //! linear drift), the readings are turned into L θ with θ = asin(x/L) (the sensor
 //! reads L sin θ: 0.1 mm on a 150 mm release), and the impacts are located roughly
@@ -502,7 +503,9 @@ struct Prepared {
     /// Displacement relative to the final rest line, spikes replaced (mm).
     x: Vec<f64>,
     sigma: f64,
-    spikes: usize,
+    /// Samples the spike filter replaced (indices, increasing): left out of
+    /// the global fit.
+    spikes: Vec<usize>,
     dt: f64,
     /// First sample of the release.
     departure: usize,
@@ -599,7 +602,7 @@ fn by_savgol(t: &[f64], p: Prepared, filter: SavGol, n_peaks: usize) -> Analysis
         displacement_mm: p.x,
         fit_curve: Vec::new(),
         noise_mm: p.sigma,
-        spikes_removed: p.spikes,
+        spikes_removed: p.spikes.len(),
         p_fit: None,
         lambda_fit: None,
         rms_mm: None,
@@ -805,6 +808,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     let fit = SegmentFit::run(&FitInput {
         t,
         x: &p.x,
+        replaced: &p.spikes,
         rest: 0.0,
         sigma: p.sigma,
         departure: p.departure,
@@ -972,7 +976,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         displacement_mm: p.x,
         fit_curve: fit.curve(),
         noise_mm: p.sigma,
-        spikes_removed: p.spikes + fit.outliers,
+        spikes_removed: p.spikes.len() + fit.outliers,
         p_fit: Some(fit.model().p()),
         lambda_fit: fit.model().lambda(),
         rms_mm: Some(fit.rms),

@@ -61,6 +61,9 @@ pub struct SegmentFit {
 pub struct FitInput<'a> {
     pub t: &'a [f64],
     pub x: &'a [f64],
+    /// Samples the spike filter replaced (indices into `t`, increasing): not
+    /// data, so left out of the fit (`prepare::remove_isolated_spikes`).
+    pub replaced: &'a [usize],
     pub rest: f64,
     pub sigma: f64,
     pub departure: usize,
@@ -88,11 +91,12 @@ impl SegmentFit {
         let end_t = crossings[m - 1] - 0.25 * dt;
         let i0 = t.partition_point(|&v| v < start_t);
         let i1 = t.partition_point(|&v| v <= end_t);
-        let mut tw = t[i0..i1].to_vec();
+        let kept: Vec<usize> = (i0..i1).filter(|i| inp.replaced.binary_search(i).is_err()).collect();
+        let mut tw: Vec<f64> = kept.iter().map(|&i| t[i]).collect();
         // L θ from the sensor's L sin θ.
-        let mut yw: Vec<f64> = x[i0..i1]
+        let mut yw: Vec<f64> = kept
             .iter()
-            .map(|&v| rest + lever * ((v - rest) / lever).clamp(-1.0, 1.0).asin())
+            .map(|&i| rest + lever * ((x[i] - rest) / lever).clamp(-1.0, 1.0).asin())
             .collect();
         if tw.len() < 3 * m + 8 {
             return Err(PeakError::FitWindow(tw.len()));
@@ -165,7 +169,7 @@ impl SegmentFit {
             penalty,
             contacts: best_contacts.as_ref(),
         };
-        let (estimated, filter_dropped) = match rival_filter(inp.estimate_filter && misses, &rivals, &tw, &yw, inp.sigma) {
+        let (estimated, filter_dropped) = match rival_filter(inp.estimate_filter && misses, &rivals, (&tw, &yw), dt, inp.sigma) {
             Ok(found) => (Some(found), None),
             Err(why) => (None, why),
         };
@@ -320,11 +324,10 @@ fn leaning_contacts(simple: &Fitted, c: &Fitted, sigma2: f64, table: usize) -> O
 /// Where `look` (no filter stated, the plain fit misses the samples around its
 /// impacts): an estimated low-pass, if it beats `chosen` ([`super::acquisition::rival`]).
 type Rival = Result<(super::acquisition::Estimate, Vec<Vec<f64>>), Option<String>>;
-fn rival_filter(look: bool, rivals: &super::acquisition::Rivals, tw: &[f64], yw: &[f64], sigma: f64) -> Rival {
+fn rival_filter(look: bool, rivals: &super::acquisition::Rivals, (tw, yw): (&[f64], &[f64]), dt: f64, sigma: f64) -> Rival {
     if !look {
         return Err(None);
     }
-    let dt = (tw[tw.len() - 1] - tw[0]) / (tw.len() - 1) as f64;
     super::acquisition::rival(rivals, tw, yw, dt, sigma)
 }
 

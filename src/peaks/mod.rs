@@ -1038,3 +1038,20 @@ fn deferred_structured(fit: &SegmentFit, resid: &[f64], methods: &[ReadingMethod
         impacts: standing.iter().map(|&(k, _)| k).collect(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::beside_impacts;
+
+    #[test]
+    fn replaced_samples_beside_an_impact_are_the_ones_left_out() {
+        let dt = 0.01;
+        let t: Vec<f64> = (0..200).map(|i| i as f64 * dt).collect();
+        // Impacts (rough crossings) between samples 50 and 51, and at 120.3.
+        let crossings = [0.505, 1.203];
+        // Within 3 samples: 48 and 53 (2.5 samples), 123 (2.7); not 47 and 54
+        // (3.5), 117 (3.3) or 124 (3.7), nor the samples on the arcs.
+        let replaced = [10, 47, 48, 53, 54, 90, 117, 123, 124];
+        assert_eq!(beside_impacts(&t, &replaced, &crossings, dt), vec![48, 53, 123]);
+    }
+}

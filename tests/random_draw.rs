@@ -142,7 +142,10 @@ fn random_rigid_tests_full_draw() {
 /// more than 5 pp off with status ok. Measured 80.5 % ok within 1 pp, 24
 /// flagged, worst ok 1.78 pp (draw 1018; docs/acquisition.md). The success rate is
 /// printed, asserted only above 55 %: this family is where the estimator's
-/// contact model is still weak.
+/// contact model is still weak. On the seeds `DRAW_SEED_OFFSET=200000` one test
+/// is ok 5.60 pp off (201145: a wide-rounding filter estimate and the contact
+/// phases each miss its log by χ²/n 3.6; docs/accuracy.md, forty-first
+/// session), and this assertion fails there.
 #[test]
 #[ignore = "the full compliant draw: run in release (see the module docs)"]
 fn random_compliant_tests_full_draw() {

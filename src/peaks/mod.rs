@@ -61,12 +61,12 @@
 //! which reading each peak got.
 //!
 //! Before the fit: isolated spikes are replaced (and, beside an impact, where
-//! their neighbours' values would mislead it, left out of the global fit), the line through the final rest
-//! (its slope shared with the initial hold) is subtracted (the sensor's zero and a
-//! linear drift), the readings are turned into L θ with θ = asin(x/L) (the sensor
-//! reads L sin θ: 0.1 mm on a 150 mm release), and the impacts are located roughly
-//! by zero crossings with hysteresis (`prepare.rs`, `crossings.rs`). After it:
-//! the plausibility checks of [`checks`] (a test that trips one is
+//! their neighbours' values would mislead it, left out of the global fit), the
+//! line through the final rest (its slope shared with the initial hold) is
+//! subtracted (the sensor's zero and a linear drift), the readings are turned
+//! into L θ with θ = asin(x/L) (the sensor reads L sin θ: 0.1 mm on a 150 mm
+//! release), and the impacts are located roughly by zero crossings with
+//! hysteresis (`prepare.rs`, `crossings.rs`). After it: the plausibility checks of [`checks`] (a test that trips one is
 //! [`Quality::Suspect`]; residuals that stand out around an impact only where
 //! local readings of the peaks do not vouch for them, `vouch.rs`) and the covariance of the peaks with its model-form
 //! terms (`uncertainty.rs`).

@@ -422,9 +422,9 @@ impl Model {
     }
 
     /// The exact gravity arc of half-length `half` (s) for this model's α and
-    /// p (p² = p_s² / cos α, p_s = `ps` as [`Model::p_small`] gives it), about its linearised arc (A_k, p_k of
-    /// [`Model::gravity_arc_params`]); None where the lever is not known
-    /// (infinite) or the arc has no length.
+    /// p (p² = p_s² / cos α, p_s = `ps` as [`Model::p_small`] gives it),
+    /// about its linearised arc (A_k, p_k of [`Model::gravity_arc_params`]);
+    /// None where the lever is not known (infinite) or the arc has no length.
     fn exact_arc(&self, half: f64, a: f64, p: f64, ps: f64) -> Option<GravityArc> {
         if !self.lever.is_finite() {
             return None;

@@ -16,12 +16,9 @@ use crate::signal::median;
 /// impact between them: on a stiff restraint's arcs b then made a kink pass
 /// for a spike) and b is 0. The sample is replaced by the value that gives
 /// d₂ = b there, (x[i−1] + x[i+1] − b)/2, not by its neighbours' mean, which
-/// is off by b/2 on a curved arc. Returns the indices replaced: the global
-/// fit leaves them out (`segments.rs`), since next to an impact no value
-/// from the neighbours is the wall's (unstated Bessel draw 203065 of
-/// `DRAW_SEED_OFFSET=200000`: a spike one sample after a kink at 100 Hz,
-/// replaced 0.26 mm (15 σ) off, tipped the choice between a filter and
-/// contact phases, and the test was ok at 3.3 pp).
+/// is off by b/2 on a curved arc. Returns the indices replaced; those beside
+/// an impact, where the neighbours may straddle its kink, are left out of the
+/// global fit (`peaks::beside_impacts`).
 pub(super) fn remove_isolated_spikes(x: &mut [f64], threshold: f64) -> Vec<usize> {
     let n = x.len();
     let mut replaced = Vec::new();

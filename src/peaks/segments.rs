@@ -61,8 +61,8 @@ pub struct SegmentFit {
 pub struct FitInput<'a> {
     pub t: &'a [f64],
     pub x: &'a [f64],
-    /// Samples the spike filter replaced (indices into `t`, increasing): not
-    /// data, so left out of the fit (`prepare::remove_isolated_spikes`).
+    /// Samples left out of the fit (indices into `t`, increasing): those the
+    /// spike filter replaced beside an impact (`peaks::beside_impacts`).
     pub replaced: &'a [usize],
     pub rest: f64,
     pub sigma: f64,

@@ -1267,6 +1267,24 @@ fn a_two_sided_lag_past_the_tables_peaks_is_no_reason_to_flag() {
     assert_issue_18(name, holdout_summary(name));
 }
 
+/// A wall made with the public-like two-sided preset (`--preset
+/// public-like-two-sided --seed 4107`, forty-first session). Its 1000 Hz test
+/// Q2_130_1 was ok with r₁⁻ 6.85 pp off (± 3.03): no local window wider than
+/// 9 samples fitted peak 2 to the noise, 9 samples before its crossing of
+/// θ = 0, so the test against an instantaneous impact at the crossing had no
+/// sample to judge, and the corner read on those 9 samples was 15 % off
+/// (u 7.5 %). A window that does not reach the crossing now leaves the peak
+/// unresolved, and the test keeps the global fit's readings (`peaks::local`).
+/// Asserted: issue 18's criterion, and every ok value within the goal of
+/// 0.5 pp (measured: 0.27 pp; Q2_130_1 0.17 pp; the 70 mm test is flagged).
+#[test]
+fn a_local_window_short_of_the_crossing_reads_no_peak() {
+    let name = "mujoco-public-like-two-sided-s4107";
+    let (flagged, worst, within) = holdout_summary(name);
+    assert_issue_18(name, (flagged, worst, within));
+    assert!(worst <= 0.5, "{name}: an ok test {worst:.2} pp off");
+}
+
 /// Issue 18's criterion on one campaign's (flagged, worst ok value in pp,
 /// share of the ok tests' peaks within 2 u): at most one test flagged, every
 /// ok value within 1.0 pp, ≥ 90 % of the peaks within 2 u.

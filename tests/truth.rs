@@ -1245,10 +1245,7 @@ fn a_fresh_two_sided_wall_meets_the_issue() {
 /// test is flagged, its late contact phases long beside their half-cycles).
 #[test]
 fn late_two_sided_contacts_follow_the_impacts_speeds() {
-    let name = "mujoco-two-sided-late-contacts";
-    let (flagged, worst, within) = holdout_summary(name);
-    assert_issue_18(name, (flagged, worst, within));
-    assert!(worst <= 0.5, "{name}: an ok test {worst:.2} pp off");
+    assert_issue_18_within_goal("mujoco-two-sided-late-contacts");
 }
 
 /// A wall made with the two-sided hold-out preset (`--preset
@@ -1279,7 +1276,12 @@ fn a_two_sided_lag_past_the_tables_peaks_is_no_reason_to_flag() {
 /// 0.5 pp (measured: 0.27 pp; Q2_130_1 0.17 pp; the 70 mm test is flagged).
 #[test]
 fn a_local_window_short_of_the_crossing_reads_no_peak() {
-    let name = "mujoco-public-like-two-sided-s4107";
+    assert_issue_18_within_goal("mujoco-public-like-two-sided-s4107");
+}
+
+/// Issue 18's criterion on one campaign, and every ok value within the
+/// issue's goal of 0.5 pp.
+fn assert_issue_18_within_goal(name: &str) {
     let (flagged, worst, within) = holdout_summary(name);
     assert_issue_18(name, (flagged, worst, within));
     assert!(worst <= 0.5, "{name}: an ok test {worst:.2} pp off");

@@ -449,6 +449,9 @@ pub(crate) mod tests {
     /// sampled every `dt` from τ = −0.2 s, the rest line crossed at τ = `zero`:
     /// (t, displacement, the true velocity extreme).
     fn contact_log(dt: f64, zero: f64) -> (Vec<f64>, Vec<f64>, f64) {
+        // Velocity: −(100 + 200 τ) before the contact (gravity speeds the wall
+        // up), then a smooth blend over 40 ms into −60 + 200 (τ − 0.04) (the
+        // next half-cycle, where gravity slows it); displacement by integration.
         let after = |tau: f64| -60.0 + 200.0 * (tau - 0.04);
         let vel = |tau: f64| {
             let free = -(100.0 + 200.0 * tau);

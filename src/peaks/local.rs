@@ -256,15 +256,16 @@ fn family_fit(t: &[f64], y: &[f64], t0: f64, h: f64, dt: f64, sigma: f64, smooth
 
 /// χ² of the instantaneous impact on the window of `q`: the kink shape with its
 /// jump within one sample of the log's crossing of θ = 0 (every quarter
-/// sample); infinite where the window does not reach the crossing (then
-/// nothing is ruled out, and [`read`] reads nothing).
-fn kink_at_crossing_chi2(t: &[f64], y: &[f64], t0: f64, q: &LocalFit, zero: f64, dt: f64, sigma: f64) -> f64 {
+/// sample); None where the window does not reach the crossing (then nothing
+/// is ruled out, and [`read`] reads nothing).
+fn kink_at_crossing_chi2(t: &[f64], y: &[f64], t0: f64, q: &LocalFit, zero: f64, dt: f64, sigma: f64) -> Option<f64> {
     (0..=8)
         .map(|i| (zero - t0 + (i as f64 / 4.0 - 1.0) * dt) / q.h)
         .filter(|s| s.abs() < 1.0)
         .filter_map(|s| LocalFit::fit(t, y, t0, q.h, sigma, Shape::Kink(s)))
         .map(|f| f.chi2)
-        .fold(f64::INFINITY, f64::min)
+        .filter(|c| c.is_finite())
+        .min_by(f64::total_cmp)
 }
 
 /// Half-widths tried (samples), growing by about a quarter.
@@ -324,8 +325,8 @@ pub fn read(t: &[f64], y: &[f64], t_peak: f64, want: f64, dt: f64, max_half: usi
     // The data must rule out an instantaneous impact at the crossing, not
     // merely allow a smooth shape; a window that does not reach the crossing
     // cannot.
-    let kink = kink_at_crossing_chi2(t, y, centre, &q, zero, dt, sigma);
-    if !kink.is_finite() || kink < q.chi2 + KINK_EVIDENCE.max((q.n as f64).ln()) {
+    let kink = kink_at_crossing_chi2(t, y, centre, &q, zero, dt, sigma)?;
+    if kink < q.chi2 + KINK_EVIDENCE.max((q.n as f64).ln()) {
         return None;
     }
     let u_fit = q.u_slope(s, sigma);

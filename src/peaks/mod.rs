@@ -66,10 +66,11 @@
 //! subtracted (the sensor's zero and a linear drift), the readings are turned
 //! into L θ with θ = asin(x/L) (the sensor reads L sin θ: 0.1 mm on a 150 mm
 //! release), and the impacts are located roughly by zero crossings with
-//! hysteresis (`prepare.rs`, `crossings.rs`). After it: the plausibility checks of [`checks`] (a test that trips one is
-//! [`Quality::Suspect`]; residuals that stand out around an impact only where
-//! local readings of the peaks do not vouch for them, `vouch.rs`) and the covariance of the peaks with its model-form
-//! terms (`uncertainty.rs`).
+//! hysteresis (`prepare.rs`, `crossings.rs`). After it: the plausibility
+//! checks of [`checks`] (a test that trips one is [`Quality::Suspect`];
+//! residuals that stand out around an impact only where local readings of the
+//! peaks do not vouch for them, `vouch.rs`) and the covariance of the peaks
+//! with its model-form terms (`uncertainty.rs`).
 //!
 //! Assumptions: free vibration (no base motion), the release from rest on the
 //! outward side, a sensor drift that is linear over the record, white noise, a

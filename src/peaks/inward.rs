@@ -120,6 +120,27 @@
 //! the contact model (measured, offline, at the same 2.5), 22 of 39 changed
 //! tests read worse, by up to 0.48 pp.
 //!
+//! # A misfit landing
+//! A late landing (k even, from [`FIRST_LATE_LANDING`]) whose impact the
+//! deferred reason names ([`super::Analysis::deferred_misfit`]: the global
+//! fit's residuals within ± 2 samples of it spread more than 8 σ, and the test
+//! is flagged unless the contact model reads the peak, "Residuals that stand
+//! out" below) takes its contact reading even where that misses the noise,
+//! up to χ²/ν = [`MISFIT_LIMIT`], its u scaled by √(χ²/ν) and within
+//! [`LOOSE_PUSH`] of the speed: the pushes' fallback, where the global reading
+//! cannot be vouched for. Elsewhere a landing's reading must fit the noise.
+//!
+//! Why (forty-third session): on 1000 Hz public-like one-sided walls the
+//! contact model's χ²/ν over a landing's 200-odd samples is 1.2–1.7, a small
+//! misfit of its form that the noise level's own bias on quantised logs
+//! (docs/estimator.md, "The noise level") can make out of nothing; the global
+//! fit read those landings +3.0 and +3.3 % (q1-s4304 and q1-s4325 Q1_150_1,
+//! residuals 13.7 and 10.5 σ around impact 4) and the contact model −0.7 %
+//! both times (χ²/ν 1.64 and 1.28). Measured (release, `engine_campaigns`,
+//! 28 one-sided MuJoCo campaigns drawn that session, seeds 4301–4325): those
+//! two tests became ok, 0.85 → 0.67 and 0.92 → 0.58 pp off; no other test's
+//! status or worst value moved; issue 18's criterion 18 → 20 of 28.
+//!
 //! # Residuals that stand out
 //! On a log the rule applies to, residuals that stand out around an impact
 //! ([`super::checks::structured_near_impacts`]: the global fit's contact
@@ -350,13 +371,26 @@ fn gains_energy(a: &Analysis, new: &[Replacement]) -> bool {
 /// The late landings of the table (k even, from [`FIRST_LATE_LANDING`] on)
 /// whose global fit's residuals stand out ([`Analysis::local_misfit`] at least
 /// [`LANDING_STANDS_OUT`]) and whose contact reading fits the samples to the
-/// noise: those readings (module docs, "Late landings").
+/// noise: those readings (module docs, "Late landings"). At a landing whose
+/// impact the deferred reason names ([`Analysis::deferred_misfit`]: the global
+/// fit's residuals there stand out at 8 σ, and the test is flagged unless the
+/// contact model reads the peak), a reading up to χ²/ν = [`MISFIT_LIMIT`] is
+/// taken, its u scaled by √(χ²/ν), if that u is within [`LOOSE_PUSH`] of the
+/// speed: the pushes' fallback, where the global reading cannot be vouched
+/// for (module docs, "A misfit landing").
 fn late_landings(a: &Analysis, read: &[ContactPeak]) -> Vec<Replacement> {
+    let named = |k: usize| a.deferred_misfit.as_ref().is_some_and(|m| m.impacts.contains(&k));
     (FIRST_LATE_LANDING..a.peaks.len())
         .step_by(2)
         .filter(|&k| a.local_misfit.get(k).copied().flatten().is_some_and(|z| z >= LANDING_STANDS_OUT))
         .filter_map(|k| {
-            let c = read.iter().find(|q| q.k == k)?.reading.filter(|c| c.fits_noise())?;
+            let c = read.iter().find(|q| q.k == k)?.reading?;
+            let c = if named(k) {
+                c.scaled_to_misfit(MISFIT_LIMIT)
+                    .filter(|c| c.reading.u_mm_s <= LOOSE_PUSH * c.reading.velocity_mm_s.abs())?
+            } else {
+                Some(c).filter(|c| c.fits_noise())?
+            };
             replacement(a, k, c)
         })
         .collect()
@@ -533,6 +567,41 @@ mod tests {
         assert!(late_landings(&with(5.0, 1.0), &read).is_empty());
         // χ² = 500 over ν = 55: the reading misses the noise.
         assert!(late_landings(&with(1.0, 3.0), &[reading(4, -250.0, 1.0, 500.0)]).is_empty());
+    }
+
+    /// A landing whose impact the deferred reason names (the global fit's
+    /// residuals stand out there at 8 σ) takes a contact reading that misses
+    /// the noise up to χ²/ν = [`MISFIT_LIMIT`], its u scaled by √(χ²/ν); not
+    /// where no reason names it, not beyond the limit, not where the scaled u
+    /// exceeds [`LOOSE_PUSH`] of the speed.
+    #[test]
+    fn a_misfit_landing_is_read_only_where_the_deferred_reason_names_it() {
+        let v = [-500.0, 400.0, -350.0, 300.0, -260.0, 220.0];
+        let named = |impacts: Vec<usize>| {
+            let mut a = analysis(&v, 5.0);
+            a.local_misfit = vec![None, None, None, None, Some(3.0), None];
+            a.deferred_misfit = Some(crate::peaks::DeferredMisfit {
+                reason: "the residuals around impact 4 stand out".into(),
+                impacts,
+            });
+            a
+        };
+        // χ² = 110 over ν = 55: χ²/ν = 2, past the noise's 86.5.
+        let misfit = [reading(4, -250.0, 1.0, 110.0)];
+        let new = late_landings(&named(vec![4]), &misfit);
+        assert_eq!(new.len(), 1);
+        assert_eq!((new[0].k, new[0].velocity_mm_s), (4, -250.0));
+        assert!((new[0].reading_u_mm_s - 2f64.sqrt()).abs() < 1e-12);
+        // u² = 2 + 2.5² (model form) + 10² (the disagreement).
+        assert!((new[0].u_mm_s - 108.25f64.sqrt()).abs() < 1e-12);
+        // Another impact named, or none: the misfit reading is not taken.
+        assert!(late_landings(&named(vec![2]), &misfit).is_empty());
+        let mut unnamed = named(vec![4]);
+        unnamed.deferred_misfit = None;
+        assert!(late_landings(&unnamed, &misfit).is_empty());
+        // χ²/ν = 6 is past the limit; a scaled u of 13.4 mm/s is past 5 % of 250.
+        assert!(late_landings(&named(vec![4]), &[reading(4, -250.0, 1.0, 330.0)]).is_empty());
+        assert!(late_landings(&named(vec![4]), &[reading(4, -250.0, 9.5, 110.0)]).is_empty());
     }
 
     /// Every odd peak read at the noise: replaced, u the larger of the

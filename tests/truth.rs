@@ -1305,6 +1305,31 @@ fn a_misfit_landing_the_reason_names_is_read_by_the_contact_model() {
     assert_eq!(a.methods[4], rocklab::peaks::ReadingMethod::ContactModel);
 }
 
+/// A wall made with the hold-out one-sided preset (`--preset
+/// holdout-one-sided --seed 4312`, forty-third session). Its 500 Hz test
+/// H1_130_1 was flagged for the global fit's residuals around impact 6
+/// (8.6 σ), the landing that ends peak 6, past the table's six peaks: the
+/// contact model reads the table's peaks, nothing reads one past it, and the
+/// reason stayed; with the 100 Hz test, flagged for its short excursions, the
+/// campaign had two tests flagged. Re-fitted without the samples around
+/// impact 6, no peak of the table moves by more than 0.3 of its u, and the
+/// residuals there are no reason now (`peaks::past_the_table`). Asserted:
+/// issue 18's criterion (measured: the 100 Hz test flagged, the ok tests
+/// within 0.71 pp), and H1_130_1 ok within 1.0 pp (measured: 0.58 pp) with
+/// the report's note on the impact past the table.
+#[test]
+fn residuals_past_the_table_that_move_no_peak_are_no_reason() {
+    let name = "mujoco-holdout-one-sided-s4312";
+    let rep = holdout_report(name);
+    assert_issue_18(name, summary_of(name, &rep));
+    let h = rep.iter().find(|r| r.0 == "H1_130_1").expect("H1_130_1 in the campaign");
+    assert!(h.2 && h.1 <= 1.0, "H1_130_1: ok {}, {:.2} pp off", h.2, h.1);
+    let (res, _) = reduced_with_truth(name);
+    let t = res.tests.iter().find(|t| t.spec.id == "H1_130_1").expect("H1_130_1");
+    let note = t.result.as_ref().expect("reduced").analysis.model_note.clone().unwrap_or_default();
+    assert!(note.contains("past the table's peaks (impact 6"), "{note}");
+}
+
 /// Issue 18's criterion on one campaign, and every ok value within the
 /// issue's goal of 0.5 pp.
 fn assert_issue_18_within_goal(name: &str) {

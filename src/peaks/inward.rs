@@ -150,7 +150,9 @@
 //! now reads every peak that ends at one of those impacts (peak j ends at
 //! impact j: a push's exit, or a late landing; [`reads_past`]). Peak 0 (the
 //! release arc's end) and peak 2 keep the global reading, so a misfit there
-//! keeps the reason; so does one past the table, and one at a push whose
+//! keeps the reason; so does one past the table (unless the table's peaks do
+//! not depend on its samples, [`super::past_the_table`], which leaves it out
+//! of the list first), and one at a push whose
 //! contact reading misses the noise while the global fit reads the pushes
 //! well. The replaced peaks carry the readings' disagreement in their u as
 //! above.

@@ -964,11 +964,14 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
     // Residuals that stand out around impacts of such a log are a reason only
     // where the contact model does not read the peaks there (`inward`, after
     // this fit): deferred, with the impacts.
-    let deferred_misfit = if pushes_rereadable && !exits_misfit {
-        deferred_structured(&fit, &resid, &methods, p.dt, p.sigma)
+    let (deferred_misfit, past_note) = if pushes_rereadable && !exits_misfit {
+        let u: Vec<f64> = peaks.iter().map(|q| q.velocity_u_mm_s.unwrap_or(0.0)).collect();
+        deferred_structured(&fit, &resid, &methods, (&impacts, &u), p.dt, p.sigma)
     } else {
-        None
+        (None, None)
     };
+    let past_the_table_checked = past_note.is_some();
+    let model_note = model_note.or(past_note);
     let verdict = quality::plausibility(
         &fit,
         &resid,
@@ -977,7 +980,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         &spread_checked,
         &methods,
         (p.dt, p.sigma),
-        exits_misfit || deferred_misfit.is_some(),
+        exits_misfit || deferred_misfit.is_some() || past_the_table_checked,
         &late,
     );
     let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
@@ -1029,15 +1032,76 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
 
 /// [`checks::structured_near_impacts`] on the global fit, its onsets those of
 /// the peaks it reads (`methods`, as [`quality::plausibility`] checks them),
-/// with every impact whose residuals stand out.
-fn deferred_structured(fit: &SegmentFit, resid: &[f64], methods: &[ReadingMethod], dt: f64, sigma: f64) -> Option<DeferredMisfit> {
+/// with every impact whose residuals stand out, and the note of those left
+/// out as past the table ([`past_the_table`]). `(impacts, u)`: the fit's
+/// impacts and the table's peaks' u (mm/s).
+fn deferred_structured(
+    fit: &SegmentFit,
+    resid: &[f64],
+    methods: &[ReadingMethod],
+    (impacts, u): (&[Impact], &[f64]),
+    dt: f64,
+    sigma: f64,
+) -> (Option<DeferredMisfit>, Option<String>) {
     let onsets = quality::checked_onsets(fit.model(), methods);
-    let standing = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
-    let &(first, spread) = standing.first()?;
-    Some(DeferredMisfit {
+    let mut standing = checks::structured_impacts(&fit.tw, resid, &onsets, dt, sigma);
+    let note = past_the_table(fit, &mut standing, &onsets, (impacts, u), dt, sigma);
+    let deferred = standing.first().map(|&(first, spread)| DeferredMisfit {
         reason: checks::standing_out(first, spread, sigma),
         impacts: standing.iter().map(|&(k, _)| k).collect(),
-    })
+    });
+    (deferred, note)
+}
+
+/// Impacts past the table whose residuals stand out, taken out of `standing`
+/// where the table does not depend on their samples: impact j ends peak j, so
+/// one with j ≥ the table's peaks (`u.len()`) ends no peak of it, and where
+/// the fit re-fitted without the samples within ±[`LEAVE_OUT_SAMPLES`] of
+/// those impacts moves no peak of the table by more than [`LEAVE_OUT_MOVE`] of
+/// its u, the model's miss there says nothing of the table's peaks (the test
+/// of [`Misfit::vouched`]). Returns the report's note where it applies.
+///
+/// Forty-third session: on the one-sided MuJoCo walls a 1000 Hz test
+/// (q1-s4306 Q1_150_1) stood out at its exit 5 and at the landing after it,
+/// impact 6 (8.6 and 9.7 σ), and 200–500 Hz tests of the hold-out wall at
+/// impact 6 alone (h1-s4312 H1_130_1, h1-s4324 H1_140_2); the contact model
+/// reads the peaks of the table's impacts, but nothing reads a peak past the
+/// table, so the reason stayed (`inward::reads_past`) and the campaigns had
+/// two tests flagged (docs/accuracy.md, "Forty-third session"). Measured
+/// (release, `engine_campaigns` on the 28 one-sided campaigns drawn then,
+/// seeds 4301–4325): those three became ok, their worst values unchanged
+/// (0.74, 0.58 and 1.23 pp, the last r⁻ at 1.1 of its u), no other test
+/// moved, and issue 18's criterion went from 20 to 22 of 28.
+fn past_the_table(
+    fit: &SegmentFit,
+    standing: &mut Vec<(usize, f64)>,
+    onsets: &[f64],
+    (impacts, u): (&[Impact], &[f64]),
+    dt: f64,
+    sigma: f64,
+) -> Option<String> {
+    let n = u.len();
+    let past: Vec<(usize, f64)> = standing.iter().copied().filter(|&(k, _)| k >= n).collect();
+    if past.is_empty() || u.iter().any(|&x| x.is_nan() || x <= 0.0) {
+        return None;
+    }
+    let at: Vec<f64> = past.iter().map(|&(k, _)| onsets[k]).collect();
+    let moved = fit.peaks_without(&at, LEAVE_OUT_SAMPLES * dt, n)?;
+    let still = moved.len() == n
+        && moved
+            .iter()
+            .zip(impacts)
+            .zip(u)
+            .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk);
+    if !still {
+        return None;
+    }
+    standing.retain(|&(k, _)| k < n);
+    let each: Vec<String> = past.iter().map(|(k, r)| format!("impact {k}, {:.1} × the noise", r / sigma)).collect();
+    Some(format!(
+        "the residuals stand out past the table's peaks ({}): re-fitted without the samples around them, no peak of the table moves by more than {LEAVE_OUT_MOVE} of its u",
+        each.join("; ")
+    ))
 }
 
 #[cfg(test)]

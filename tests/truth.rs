@@ -1294,14 +1294,7 @@ fn a_local_window_short_of_the_crossing_reads_no_peak() {
 /// (measured: 0.58 pp).
 #[test]
 fn a_misfit_landing_the_reason_names_is_read_by_the_contact_model() {
-    let name = "mujoco-public-like-one-sided-s4325";
-    let rep = holdout_report(name);
-    assert_issue_18(name, summary_of(name, &rep));
-    let q = rep.iter().find(|r| r.0 == "Q1_150_1").expect("Q1_150_1 in the campaign");
-    assert!(q.2 && q.1 <= 1.0, "Q1_150_1: ok {}, {:.2} pp off", q.2, q.1);
-    let (res, _) = reduced_with_truth(name);
-    let t = res.tests.iter().find(|t| t.spec.id == "Q1_150_1").expect("Q1_150_1");
-    let a = &t.result.as_ref().expect("reduced").analysis;
+    let a = issue_18_with_ok_test("mujoco-public-like-one-sided-s4325", "Q1_150_1");
     assert_eq!(a.methods[4], rocklab::peaks::ReadingMethod::ContactModel);
 }
 
@@ -1319,15 +1312,21 @@ fn a_misfit_landing_the_reason_names_is_read_by_the_contact_model() {
 /// the report's note on the impact past the table.
 #[test]
 fn residuals_past_the_table_that_move_no_peak_are_no_reason() {
-    let name = "mujoco-holdout-one-sided-s4312";
+    let a = issue_18_with_ok_test("mujoco-holdout-one-sided-s4312", "H1_130_1");
+    let note = a.model_note.unwrap_or_default();
+    assert!(note.contains("past the table's peaks (impact 6"), "{note}");
+}
+
+/// Issue 18's criterion on one campaign, and its test `id` ok within 1.0 pp:
+/// that test's analysis.
+fn issue_18_with_ok_test(name: &str, id: &str) -> rocklab::peaks::Analysis {
     let rep = holdout_report(name);
     assert_issue_18(name, summary_of(name, &rep));
-    let h = rep.iter().find(|r| r.0 == "H1_130_1").expect("H1_130_1 in the campaign");
-    assert!(h.2 && h.1 <= 1.0, "H1_130_1: ok {}, {:.2} pp off", h.2, h.1);
+    let r = rep.iter().find(|r| r.0 == id).unwrap_or_else(|| panic!("{id} in {name}"));
+    assert!(r.2 && r.1 <= 1.0, "{id}: ok {}, {:.2} pp off", r.2, r.1);
     let (res, _) = reduced_with_truth(name);
-    let t = res.tests.iter().find(|t| t.spec.id == "H1_130_1").expect("H1_130_1");
-    let note = t.result.as_ref().expect("reduced").analysis.model_note.clone().unwrap_or_default();
-    assert!(note.contains("past the table's peaks (impact 6"), "{note}");
+    let t = res.tests.into_iter().find(|t| t.spec.id == id).unwrap_or_else(|| panic!("{id}"));
+    t.result.unwrap_or_else(|e| panic!("{id}: {e}")).analysis
 }
 
 /// Issue 18's criterion on one campaign, and every ok value within the

@@ -131,9 +131,9 @@
 //! cannot be vouched for. Elsewhere a landing's reading must fit the noise.
 //!
 //! Why (forty-third session): on 1000 Hz public-like one-sided walls the
-//! contact model's χ²/ν over a landing's 200-odd samples is 1.2–1.7, a small
-//! misfit of its form that the noise level's own bias on quantised logs
-//! (docs/estimator.md, "The noise level") can make out of nothing; the global
+//! contact model's χ²/ν over a landing's 200-odd samples is 1.2–1.7 (a small
+//! misfit of its form, or in part the noise level's bias on quantised logs,
+//! docs/estimator.md, "The noise level": not told apart); the global
 //! fit read those landings +3.0 and +3.3 % (q1-s4304 and q1-s4325 Q1_150_1,
 //! residuals 13.7 and 10.5 σ around impact 4) and the contact model −0.7 %
 //! both times (χ²/ν 1.64 and 1.28). Measured (release, `engine_campaigns`,

@@ -13,8 +13,11 @@ use rocklab::reduce::reduce_campaign;
 
 const KEYS: [&str; 7] = ["r", "r_plus", "r_minus", "r1", "r1_plus", "r1_minus", "r2"];
 
-/// A fixture campaign; with `unstated`, its manifest without the lines that
-/// state the logger's filter (the lab that does not know it: issue #18).
+/// The fixture campaign `name`'s directory.
+fn fixture_dir(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name)
+}
+
 /// The shipped fixture `name` reduced as its manifest says, and its truth.json.
 fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
     reduced_with_options(name, PeakOptions::default())
@@ -22,7 +25,7 @@ fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_jso
 
 /// As [`reduced_with_truth`], with the estimator's `options`.
 fn reduced_with_options(name: &str, options: PeakOptions) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     (reduce_campaign(load_campaign(name, false), options), truth)
 }
@@ -44,18 +47,17 @@ fn ok_with_pushes_read_by_the_contact_model(name: &str) -> (rocklab::reduce::Cam
 /// one test: no other test to say what its wall's contacts are), with the
 /// campaign's truth.
 fn reduced_alone(name: &str, id: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
     alone.tests.retain(|t| t.id == id);
     (reduce_campaign(alone, PeakOptions::default()), truth)
 }
 
+/// A fixture campaign; with `unstated`, its manifest without the lines that
+/// state the logger's filter (the lab that does not know it: issue #18).
 fn load_campaign(name: &str, unstated: bool) -> Campaign {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/campaigns")
-        .join(name)
-        .join("campaign.toml");
+    let path = fixture_dir(name).join("campaign.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let text: String = if unstated {
         text.lines()
@@ -73,7 +75,7 @@ fn max_errors(name: &str) -> Vec<(String, f64)> {
 }
 
 fn max_errors_of(name: &str, unstated: bool) -> Vec<(String, f64)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let campaign = load_campaign(name, unstated);
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let res = reduce_campaign(campaign, PeakOptions::default());
@@ -211,7 +213,7 @@ fn mujoco_one_sided_within_one_point() {
 
 /// A shipped campaign reduced with the default estimator.
 fn load(name: &str) -> rocklab::reduce::CampaignResult {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default())
 }
 
@@ -454,7 +456,7 @@ fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
     use rocklab::reduce::{physics, read_log};
     use rocklab::report::quality::{kind, Kind};
     let name = "mujoco-holdout-one-sided";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     for spec in &campaign.tests {
@@ -522,7 +524,7 @@ fn contact_phases_from_the_campaign_only_where_it_shows_them() {
 #[test]
 fn a_contact_is_not_read_as_an_estimated_filter() {
     let name = "mujoco-public-like-two-sided-100hz";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let res = reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default());
     let mut ruled_out = 0;
@@ -818,7 +820,7 @@ fn a_collapsed_contact_lead_carries_the_unresolved_onset() {
 fn a_shared_local_shape_term_cancels_in_the_ratios() {
     use rocklab::peaks::ReadingMethod;
     let name = "mujoco-public-like-two-sided-100hz";
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+    let dir = fixture_dir(name);
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let spec = campaign.tests.iter().find(|t| t.id == "Q2_90_1").unwrap().clone();
@@ -857,7 +859,7 @@ fn mujoco_at_100_hz_is_reduced_or_flagged() {
     use rocklab::peaks::analyse;
     use rocklab::reduce::{physics, read_log};
     for name in ["mujoco-public-one-sided", "mujoco-public-two-sided"] {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+        let dir = fixture_dir(name);
         let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
         let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
         let mut ok = 0;
@@ -1018,7 +1020,7 @@ fn accuracy_table() {
             ("rocklab (default)", Method::Segments),
             ("Savitzky–Golay 11/3 + peaks", Method::SavGol(SavGol::new(11, 3).unwrap())),
         ] {
-            let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name);
+            let dir = fixture_dir(name);
             let campaign = load_campaign(name, unstated);
             let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
             let res = reduce_campaign(
@@ -1043,15 +1045,24 @@ fn accuracy_table() {
     }
 }
 
+/// One test's row of [`holdout_report`]: its id, worst |error| (pp) of its
+/// table values, whether its status is ok, and |error| / u of its peaks.
+type ReportRow = (String, f64, bool, Vec<f64>);
+
 /// Per test of a campaign: worst |error| (pp) of its table values, whether its
 /// status is ok, and |error| / u of each of its first six peaks (u the stated
 /// standard uncertainty).
-fn holdout_report(name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
-    engine_report(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name), name)
+fn holdout_report(name: &str) -> Vec<ReportRow> {
+    engine_report(&fixture_dir(name), name)
 }
 
 /// [`holdout_report`] of the campaign in `dir` (truth.json with `peaks`).
-fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
+fn engine_report(dir: &Path, name: &str) -> Vec<ReportRow> {
+    engine_reduction(dir, name).1
+}
+
+/// The reduction of the campaign in `dir` and its [`holdout_report`].
+fn engine_reduction(dir: &Path, name: &str) -> (rocklab::reduce::CampaignResult, Vec<ReportRow>) {
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let e_h = campaign.e_housner;
     let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
@@ -1108,7 +1119,7 @@ fn engine_report(dir: &Path, name: &str) -> Vec<(String, f64, bool, Vec<f64>)> {
         }
         out.push((t.spec.id.clone(), worst, r.analysis.quality.is_ok(), z));
     }
-    out
+    (res, out)
 }
 
 /// Each of the first six peaks of one test as read locally (smooth extreme,
@@ -1170,7 +1181,7 @@ fn holdout_summary(name: &str) -> (usize, f64, f64) {
     summary_of(name, &holdout_report(name))
 }
 
-fn summary_of(name: &str, rep: &[(String, f64, bool, Vec<f64>)]) -> (usize, f64, f64) {
+fn summary_of(name: &str, rep: &[ReportRow]) -> (usize, f64, f64) {
     let flagged = rep.iter().filter(|r| !r.2).count();
     let worst_ok = rep.iter().filter(|r| r.2).map(|r| r.1).fold(0.0, f64::max);
     let z: Vec<f64> = rep.iter().filter(|r| r.2).flat_map(|r| r.3.clone()).collect();
@@ -1320,11 +1331,10 @@ fn residuals_past_the_table_that_move_no_peak_are_no_reason() {
 /// Issue 18's criterion on one campaign, and its test `id` ok within 1.0 pp:
 /// that test's analysis.
 fn issue_18_with_ok_test(name: &str, id: &str) -> rocklab::peaks::Analysis {
-    let rep = holdout_report(name);
+    let (res, rep) = engine_reduction(&fixture_dir(name), name);
     assert_issue_18(name, summary_of(name, &rep));
     let r = rep.iter().find(|r| r.0 == id).unwrap_or_else(|| panic!("{id} in {name}"));
     assert!(r.2 && r.1 <= 1.0, "{id}: ok {}, {:.2} pp off", r.2, r.1);
-    let (res, _) = reduced_with_truth(name);
     let t = res.tests.into_iter().find(|t| t.spec.id == id).unwrap_or_else(|| panic!("{id}"));
     t.result.unwrap_or_else(|e| panic!("{id}: {e}")).analysis
 }

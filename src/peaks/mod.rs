@@ -789,23 +789,33 @@ struct Misfit {
 }
 
 impl Misfit {
-    /// Whether the fit re-fitted without the samples within
-    /// ±[`LEAVE_OUT_SAMPLES`] of the onsets moves no peak by more than
-    /// [`LEAVE_OUT_MOVE`] of its u (`u[k]`, mm/s) from the fit's `impacts`.
-    /// A re-fit that fails, or peaks without a u, vouch for nothing.
+    /// Whether the peaks are shown not to depend on the onsets that stand
+    /// out ([`no_peak_moves_without`]); exits only need no showing.
     fn vouched(&self, fit: &SegmentFit, impacts: &[Impact], u: &[f64], dt: f64) -> bool {
-        let Some(onsets) = &self.vouch else { return true };
-        if u.is_empty() {
-            return false;
-        }
-        fit.peaks_without(onsets, LEAVE_OUT_SAMPLES * dt, u.len()).is_some_and(|moved| {
-            moved
+        self.vouch
+            .as_ref()
+            .is_none_or(|onsets| no_peak_moves_without(fit, onsets, impacts, u, dt))
+    }
+}
+
+/// The leave-out test: whether the fit re-fitted without the samples within
+/// ±[`LEAVE_OUT_SAMPLES`] of the `onsets` gives back every peak of the table
+/// (`u.len()` of them), none moved by more than [`LEAVE_OUT_MOVE`] of its u
+/// (`u[k]`, mm/s) from the fit's `impacts`. A re-fit that fails, or peaks
+/// without a finite positive u, vouch for nothing.
+fn no_peak_moves_without(fit: &SegmentFit, onsets: &[f64], impacts: &[Impact], u: &[f64], dt: f64) -> bool {
+    let n = u.len();
+    if n == 0 || !u.iter().all(|&x| x.is_finite() && x > 0.0) {
+        return false;
+    }
+    fit.peaks_without(onsets, LEAVE_OUT_SAMPLES * dt, n).is_some_and(|moved| {
+        moved.len() == n
+            && moved
                 .iter()
                 .zip(impacts)
                 .zip(u)
                 .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk)
-        })
-    }
+    })
 }
 
 /// What the report says of an estimated low-pass that rounds the impacts as
@@ -1059,7 +1069,7 @@ fn deferred_structured(
 /// the fit re-fitted without the samples within ±[`LEAVE_OUT_SAMPLES`] of
 /// those impacts moves no peak of the table by more than [`LEAVE_OUT_MOVE`] of
 /// its u, the model's miss there says nothing of the table's peaks (the test
-/// of [`Misfit::vouched`]). Returns the report's note where it applies.
+/// of [`no_peak_moves_without`]). Returns the report's note where it applies.
 ///
 /// Forty-third session: on the one-sided MuJoCo walls a 1000 Hz test
 /// (q1-s4306 Q1_150_1) stood out at its exit 5 and at the landing after it,
@@ -1082,18 +1092,8 @@ fn past_the_table(
 ) -> Option<String> {
     let n = u.len();
     let past: Vec<(usize, f64)> = standing.iter().copied().filter(|&(k, _)| k >= n).collect();
-    if past.is_empty() || u.iter().any(|&x| x.is_nan() || x <= 0.0) {
-        return None;
-    }
     let at: Vec<f64> = past.iter().map(|&(k, _)| onsets[k]).collect();
-    let moved = fit.peaks_without(&at, LEAVE_OUT_SAMPLES * dt, n)?;
-    let still = moved.len() == n
-        && moved
-            .iter()
-            .zip(impacts)
-            .zip(u)
-            .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk);
-    if !still {
+    if past.is_empty() || !no_peak_moves_without(fit, &at, impacts, u, dt) {
         return None;
     }
     standing.retain(|&(k, _)| k < n);

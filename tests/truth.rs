@@ -1268,7 +1268,8 @@ fn late_two_sided_contacts_follow_the_impacts_speeds() {
 /// flagged for its fit, the campaign had two tests flagged. That lag lies in
 /// the fit's closing arc, from which no table value is read, and is no longer
 /// checked on two-sided walls (`peaks::checks::contact_too_long`). Asserted:
-/// issue 18's criterion (measured: H2_70_1 flagged, ok tests within 0.53 pp).
+/// issue 18's criterion (measured: H2_70_1 flagged, ok tests within 0.53 pp;
+/// since the forty-fourth session H2_70_1 is ok too, 0.71 pp off).
 #[test]
 fn a_two_sided_lag_past_the_tables_peaks_is_no_reason_to_flag() {
     let name = "mujoco-holdout-two-sided-s3504";
@@ -1326,6 +1327,35 @@ fn residuals_past_the_table_that_move_no_peak_are_no_reason() {
     let a = issue_18_with_ok_test("mujoco-holdout-one-sided-s4312", "H1_130_1");
     let note = a.model_note.unwrap_or_default();
     assert!(note.contains("past the table's peaks (impact 6"), "{note}");
+}
+
+/// A two-sided fit that misses the log smoothly and for no other reason
+/// (`peaks::CarriedMisfit`, forty-fourth session): the 70 mm test of
+/// `mujoco-holdout-two-sided-s3504` (`--preset holdout-two-sided --seed
+/// 3504`) was flagged for "the fit misses the log" alone (3.5 × the noise, in
+/// smooth humps over its half-cycles: its soft bedding's contacts are not the
+/// model's), every value within 0.71 pp. It is now read with the fit's
+/// model-form terms uncorrelated and the misfit as its note. Asserted: issue
+/// 18's criterion (measured: no test flagged, the ok tests within 0.71 pp),
+/// H2_70_1 ok within 1.0 pp, and the note.
+#[test]
+fn a_two_sided_fit_that_misses_the_log_smoothly_is_read_with_its_model_form_uncorrelated() {
+    let a = issue_18_with_ok_test("mujoco-holdout-two-sided-s3504", "H2_70_1");
+    let note = a.model_note.unwrap_or_default();
+    assert!(note.contains("misses the log smoothly") && note.contains("uncorrelated"), "{note}");
+}
+
+/// The same misfit beside another reason keeps it: the 70 mm test of
+/// `mujoco-holdout-two-sided` misses the log (4.1 × the noise) and its
+/// contact phase of impact 4 is not short beside its half-cycles; it is
+/// 3.3 pp off the truth (measured) and must stay flagged with both reasons.
+#[test]
+fn a_misfit_beside_another_reason_keeps_the_test_flagged() {
+    let (res, _) = reduced_with_truth("mujoco-holdout-two-sided");
+    let t = res.tests.iter().find(|t| t.spec.id == "H2_70_1").expect("H2_70_1");
+    let q = &t.result.as_ref().expect("reduced").analysis.quality;
+    let d = q.describe();
+    assert!(!q.is_ok() && d.contains("the fit misses the log") && d.contains("is not short"), "{d}");
 }
 
 /// Issue 18's criterion on one campaign, and its test `id` ok within 1.0 pp:

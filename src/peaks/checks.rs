@@ -8,7 +8,7 @@
 //! | [`alternation`] | the peaks do not alternate inward, outward, … |
 //! | [`energy_gain`] | a peak is faster than the one before by more than 2 % + 3 u (free rocking only loses energy) |
 //! | [`impact_gains_speed`] | the speed after an impact exceeds the speed before it by more than 3 u (e > 1) |
-//! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise |
+//! | [`misfit`] | the robust spread of the residuals (1.4826 median \|r\|) exceeds 3 × the measured noise; not where it is a two-sided test's only reason, its fit has contact phases and no filter and the spread is at most 6 × the noise: there the model-form terms are carried uncorrelated and the misfit is the model note (`peaks::CarriedMisfit`) |
 //! | [`structured_near_impacts`] | the residuals within ±2 samples of an impact spread more than 8 σ, and local readings of the peaks do not vouch for the global fit's (`vouch.rs`); not on a one-sided fit with contact phases and no filter where they stand out around exit impacts only (`peaks::exits_only_misfit`), nor where the contact model reads every peak that ends at one of the impacts where they stand out (`inward.rs`, "Residuals that stand out"), impacts past the table left out where the table's peaks do not depend on their samples (`peaks::past_the_table`) |
 //! | [`contact_too_long`] | a fitted contact phase lasts more than a third of a half-cycle it joins |
 //! | [`contact_overshoot`] | a peak inside a contact phase exceeds the free arc's speed at its onset by more than 5 % + 3 u |

@@ -781,6 +781,7 @@ const LEAVE_OUT_MOVE: f64 = 0.3;
 
 /// Residuals that stand out where the model's exits are not the wall's
 /// ([`exits_only_misfit`]).
+#[derive(Clone)]
 struct Misfit {
     note: String,
     /// The onsets to leave out where the peaks must be shown not to depend
@@ -816,6 +817,68 @@ fn no_peak_moves_without(fit: &SegmentFit, onsets: &[f64], impacts: &[Impact], u
                 .zip(u)
                 .all(|((v, p), &uk)| (v - p.v_before_mm_s).abs() <= LEAVE_OUT_MOVE * uk)
     })
+}
+
+/// The largest misfit, in units of the noise, that [`CarriedMisfit`] carries
+/// in u: above the 3 × of [`checks::misfit`], and just above the largest
+/// measured where the misfit was a test's only reason (5.4 ×, forty-fourth
+/// session, docs/accuracy.md); beyond it no test vouches for the rule.
+const CARRIED_MISFIT_MAX: f64 = 6.0;
+
+/// A two-sided fit with contact phases, seen through no logger filter, whose
+/// residuals spread more than 3 × the noise ([`checks::misfit`]) but not more
+/// than [`CARRIED_MISFIT_MAX`] × it. Where that is the test's only reason (no
+/// impact stands out, the contact phases are short, the local readings agree,
+/// no speed gained: every other check passed with the fit's own u), the peaks
+/// are read again with the model-form terms carried uncorrelated, as where a
+/// one-sided model misses the log at its exits ([`exits_only_misfit`]), and
+/// the misfit becomes the model note instead of a reason.
+///
+/// Why: on the compliant beddings of the two-sided MuJoCo walls the contact
+/// phases' shape is not the engine's, and the fit bends every arc a little
+/// to follow them (residuals in smooth humps over whole half-cycles, 3–5.4 ×
+/// the noise), while each arc alone, away from its contacts, fits the
+/// samples within 1.5 × the noise with the same p on every arc. The peaks
+/// then read 2–4 % low together, which the ratios cancel: over the 78 engine
+/// campaigns of the forty-third session and the random draws (the fixed seeds
+/// and those 200000 on) the 13 tests flagged for this reason alone were within
+/// 0.71 pp, while every one that was off by more than 1 pp had another reason
+/// too; on 50 fresh two-sided campaigns the 13 more were within 0.69 pp
+/// (docs/accuracy.md, "Forty-fourth session").
+struct CarriedMisfit {
+    reason: String,
+    note: String,
+}
+
+impl CarriedMisfit {
+    fn of(fit: &SegmentFit, resid: &[f64], phys: &Physics, sigma: f64) -> Option<Self> {
+        if phys.rocking == Rocking::OneSided || !unfiltered_contacts(fit) {
+            return None;
+        }
+        let reason = checks::misfit(resid, sigma)?;
+        let spread = checks::robust_spread(resid);
+        (spread <= CARRIED_MISFIT_MAX * sigma).then(|| CarriedMisfit {
+            reason,
+            note: format!(
+                "the fit misses the log smoothly (its residuals spread {spread:.3} mm, {:.1} × the noise, no impact standing out, every other check passed): the contact phases' shape is not the wall's, and the fit's model-form terms are carried uncorrelated (wider u on the ratios; docs/estimator.md)",
+                spread / sigma
+            ),
+        })
+    }
+
+    /// Whether the misfit is the verdict's only reason.
+    fn sole_reason(&self, q: &Quality) -> bool {
+        matches!(q, Quality::Suspect(r) if r.len() == 1 && r[0] == self.reason)
+    }
+
+    /// The verdict without the misfit where it is the only reason.
+    fn lifted(&self, q: Quality) -> Quality {
+        if self.sole_reason(&q) {
+            Quality::Ok
+        } else {
+            q
+        }
+    }
 }
 
 /// What the report says of an estimated low-pass that rounds the impacts as
@@ -917,94 +980,114 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             c
         })
     };
-    let tried = misfit.is_some();
-    let mut cov = build_cov(tried);
-    // An entry among the misfits: the peaks must not depend on its samples
-    // (the variances do not depend on how the model-form terms correlate).
-    let misfit = misfit.filter(|m| {
-        let u: Vec<f64> = cov
-            .as_ref()
-            .map_or_else(Vec::new, |c| (0..n_peaks.min(c.len())).map(|k| c[k][k].max(0.0).sqrt()).collect());
-        m.vouched(&fit, &impacts, &u, p.dt)
-    });
-    let exits_misfit = misfit.is_some();
-    if tried && !exits_misfit {
-        cov = build_cov(false);
-    }
-    let model_note = misfit.map(|m| m.note);
-    let mut peaks: Vec<Peak> = impacts
-        .iter()
-        .take(n_peaks)
-        .enumerate()
-        .map(|(k, i)| Peak {
-            time_s: i.time_s,
-            velocity_mm_s: i.v_before_mm_s,
-            // Never clamped: a variance that is not positive is caught below
-            // (checks::not_a_covariance), not stated as u = 0.
-            velocity_u_mm_s: cov.as_ref().map(|c| c[k][k].sqrt()),
-        })
-        .collect();
-    // Per impact: the local reading where the log resolves a smooth extreme.
-    let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
-    let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-    // One-sided walls: no local reading vouches (vouch.rs, "Not on one-sided walls").
-    let late = || {
-        if phys.rocking == Rocking::OneSided {
-            return Vec::new();
+    // A two-sided fit that misses the log smoothly and for no other reason
+    // (judged with the fit's own u) is read again with its model-form terms
+    // uncorrelated, the misfit its note ([`CarriedMisfit`]).
+    let carriable = CarriedMisfit::of(&fit, &resid, phys, p.sigma);
+    let mut carried = false;
+    let (peaks, cov, methods, local, model_note, deferred_reason, deferred_misfit, verdict) = loop {
+        let misfit = misfit.clone();
+        let tried = misfit.is_some() || carried;
+        let mut cov = build_cov(tried);
+        // An entry among the misfits: the peaks must not depend on its samples
+        // (the variances do not depend on how the model-form terms correlate).
+        let misfit = misfit.filter(|m| {
+            let u: Vec<f64> = cov
+                .as_ref()
+                .map_or_else(Vec::new, |c| (0..n_peaks.min(c.len())).map(|k| c[k][k].max(0.0).sqrt()).collect());
+            m.vouched(&fit, &impacts, &u, p.dt)
+        });
+        let exits_misfit = misfit.is_some();
+        if tried && !exits_misfit && !carried {
+            cov = build_cov(false);
         }
-        late_readings(t, &p, phys, &fit, n_peaks)
-    };
-    // A push whose zero readings disagree is a reason only if the contact
-    // model does not read the pushes (`inward`, after this fit): deferred.
-    let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
-    let (spread_checked, deferred_reason) = if pushes_rereadable {
-        let pick = |push: bool| -> Vec<f64> {
-            let global = |k: usize| methods.get(k) != Some(&ReadingMethod::LocalExtreme);
-            spread
-                .iter()
-                .enumerate()
-                .map(|(k, &d)| if (k % 2 == 1) == push && global(k) { d } else { 0.0 })
-                .collect()
+        let model_note = misfit
+            .map(|m| m.note)
+            .or_else(|| carriable.as_ref().filter(|_| carried).map(|c| c.note.clone()));
+        let mut peaks: Vec<Peak> = impacts
+            .iter()
+            .take(n_peaks)
+            .enumerate()
+            .map(|(k, i)| Peak {
+                time_s: i.time_s,
+                velocity_mm_s: i.v_before_mm_s,
+                // Never clamped: a variance that is not positive is caught below
+                // (checks::not_a_covariance), not stated as u = 0.
+                velocity_u_mm_s: cov.as_ref().map(|c| c[k][k].sqrt()),
+            })
+            .collect();
+        // Per impact: the local reading where the log resolves a smooth extreme.
+        let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
+        let local = quality::local_peaks(&fit, n_peaks, p.sigma);
+        // One-sided walls: no local reading vouches (vouch.rs, "Not on one-sided walls").
+        let late = || {
+            if phys.rocking == Rocking::OneSided {
+                return Vec::new();
+            }
+            late_readings(t, &p, phys, &fit, n_peaks)
         };
-        let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
-        (pick(false), checks::zero_readings_disagree(&v, &pick(true)))
-    } else {
-        (spread.clone(), None)
+        // A push whose zero readings disagree is a reason only if the contact
+        // model does not read the pushes (`inward`, after this fit): deferred.
+        let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
+        let (spread_checked, deferred_reason) = if pushes_rereadable {
+            let pick = |push: bool| -> Vec<f64> {
+                let global = |k: usize| methods.get(k) != Some(&ReadingMethod::LocalExtreme);
+                spread
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &d)| if (k % 2 == 1) == push && global(k) { d } else { 0.0 })
+                    .collect()
+            };
+            let v: Vec<f64> = peaks.iter().map(|p| p.velocity_mm_s).collect();
+            (pick(false), checks::zero_readings_disagree(&v, &pick(true)))
+        } else {
+            (spread.clone(), None)
+        };
+        // Residuals that stand out around impacts of such a log are a reason only
+        // where the contact model does not read the peaks there (`inward`, after
+        // this fit): deferred, with the impacts.
+        let (deferred_misfit, past_note) = if pushes_rereadable && !exits_misfit {
+            let u: Vec<f64> = peaks.iter().map(|q| q.velocity_u_mm_s.unwrap_or(0.0)).collect();
+            deferred_structured(&fit, &resid, &methods, (&impacts, &u), p.dt, p.sigma)
+        } else {
+            (None, None)
+        };
+        let past_the_table_checked = past_note.is_some();
+        let model_note = model_note.or(past_note);
+        let verdict = quality::plausibility(
+            &fit,
+            &resid,
+            &peaks,
+            &local,
+            &spread_checked,
+            &methods,
+            (p.dt, p.sigma),
+            exits_misfit || deferred_misfit.is_some() || past_the_table_checked,
+            &late,
+        );
+        let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
+        let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks, opts.onset));
+        // Where the uncertainties cannot be computed, none is stated (never u = 0):
+        // a peak read from the global fit that depends on parameters the log does
+        // not determine, or a covariance that is not one.
+        let global: Vec<bool> = methods.iter().map(|&m| m != ReadingMethod::LocalExtreme).collect();
+        let uncomputable = checks::undetermined_parameters(&undetermined, &global).or_else(|| cov.as_deref().and_then(checks::not_a_covariance));
+        if uncomputable.is_some() {
+            cov = None;
+            peaks.iter_mut().for_each(|p| p.velocity_u_mm_s = None);
+        }
+        let verdict = verdict.with(uncomputable);
+        let verdict = match &carriable {
+            Some(c) if carried => c.lifted(verdict),
+            _ => verdict,
+        };
+        // At most twice: the second pass reads with `carried` set.
+        if !carried && carriable.as_ref().is_some_and(|c| c.sole_reason(&verdict)) {
+            carried = true;
+            continue;
+        }
+        break (peaks, cov, methods, local, model_note, deferred_reason, deferred_misfit, verdict);
     };
-    // Residuals that stand out around impacts of such a log are a reason only
-    // where the contact model does not read the peaks there (`inward`, after
-    // this fit): deferred, with the impacts.
-    let (deferred_misfit, past_note) = if pushes_rereadable && !exits_misfit {
-        let u: Vec<f64> = peaks.iter().map(|q| q.velocity_u_mm_s.unwrap_or(0.0)).collect();
-        deferred_structured(&fit, &resid, &methods, (&impacts, &u), p.dt, p.sigma)
-    } else {
-        (None, None)
-    };
-    let past_the_table_checked = past_note.is_some();
-    let model_note = model_note.or(past_note);
-    let verdict = quality::plausibility(
-        &fit,
-        &resid,
-        &peaks,
-        &local,
-        &spread_checked,
-        &methods,
-        (p.dt, p.sigma),
-        exits_misfit || deferred_misfit.is_some() || past_the_table_checked,
-        &late,
-    );
-    let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
-    let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks, opts.onset));
-    // Where the uncertainties cannot be computed, none is stated (never u = 0):
-    // a peak read from the global fit that depends on parameters the log does
-    // not determine, or a covariance that is not one.
-    let global: Vec<bool> = methods.iter().map(|&m| m != ReadingMethod::LocalExtreme).collect();
-    let uncomputable = checks::undetermined_parameters(&undetermined, &global).or_else(|| cov.as_deref().and_then(checks::not_a_covariance));
-    if uncomputable.is_some() {
-        cov = None;
-        peaks.iter_mut().for_each(|p| p.velocity_u_mm_s = None);
-    }
-    let verdict = verdict.with(uncomputable);
     Ok(Analysis {
         release_time_s: fit.model().release_time(),
         peaks,

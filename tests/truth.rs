@@ -18,6 +18,11 @@ fn fixture_dir(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns").join(name)
 }
 
+/// The truth.json of the campaign in `dir`.
+fn truth_in(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap()
+}
+
 /// The shipped fixture `name` reduced as its manifest says, and its truth.json.
 fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
     reduced_with_options(name, PeakOptions::default())
@@ -26,7 +31,7 @@ fn reduced_with_truth(name: &str) -> (rocklab::reduce::CampaignResult, serde_jso
 /// As [`reduced_with_truth`], with the estimator's `options`.
 fn reduced_with_options(name: &str, options: PeakOptions) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
     let dir = fixture_dir(name);
-    let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     (reduce_campaign(load_campaign(name, false), options), truth)
 }
 
@@ -48,7 +53,7 @@ fn ok_with_pushes_read_by_the_contact_model(name: &str) -> (rocklab::reduce::Cam
 /// campaign's truth.
 fn reduced_alone(name: &str, id: &str) -> (rocklab::reduce::CampaignResult, serde_json::Value) {
     let dir = fixture_dir(name);
-    let truth = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     let mut alone = Campaign::load(&dir.join("campaign.toml")).unwrap();
     alone.tests.retain(|t| t.id == id);
     (reduce_campaign(alone, PeakOptions::default()), truth)
@@ -77,7 +82,7 @@ fn max_errors(name: &str) -> Vec<(String, f64)> {
 fn max_errors_of(name: &str, unstated: bool) -> Vec<(String, f64)> {
     let dir = fixture_dir(name);
     let campaign = load_campaign(name, unstated);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     let res = reduce_campaign(campaign, PeakOptions::default());
     let mut worst = vec![0.0f64; KEYS.len()];
     let mut suspect = Vec::new();
@@ -166,7 +171,7 @@ fn daq_response_is_recorded() {
         assert_eq!(r.source, "stated", "{}", t.spec.id);
     }
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/daq-public-bessel-1");
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     let unstated = reduce_campaign(load_campaign("daq-public-bessel-1", true), PeakOptions::default());
     for t in &unstated.tests {
         let r = &t.result.as_ref().unwrap().analysis.response;
@@ -458,7 +463,7 @@ fn a_free_arc_end_that_runs_past_its_slope_is_flagged() {
     let name = "mujoco-holdout-one-sided";
     let dir = fixture_dir(name);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     for spec in &campaign.tests {
         let log = read_log(spec).unwrap();
         let step = (0.01 / (log.time_s[1] - log.time_s[0])).round().max(1.0) as usize;
@@ -525,7 +530,7 @@ fn contact_phases_from_the_campaign_only_where_it_shows_them() {
 fn a_contact_is_not_read_as_an_estimated_filter() {
     let name = "mujoco-public-like-two-sided-100hz";
     let dir = fixture_dir(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     let res = reduce_campaign(Campaign::load(&dir.join("campaign.toml")).unwrap(), PeakOptions::default());
     let mut ruled_out = 0;
     for t in &res.tests {
@@ -821,7 +826,7 @@ fn a_shared_local_shape_term_cancels_in_the_ratios() {
     use rocklab::peaks::ReadingMethod;
     let name = "mujoco-public-like-two-sided-100hz";
     let dir = fixture_dir(name);
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let spec = campaign.tests.iter().find(|t| t.id == "Q2_90_1").unwrap().clone();
     let t = rocklab::reduce::reduce_test(&campaign, &spec, &PeakOptions::default());
@@ -861,7 +866,7 @@ fn mujoco_at_100_hz_is_reduced_or_flagged() {
     for name in ["mujoco-public-one-sided", "mujoco-public-two-sided"] {
         let dir = fixture_dir(name);
         let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
-        let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+        let truth = truth_in(&dir);
         let mut ok = 0;
         for spec in &campaign.tests {
             let log = read_log(spec).unwrap();
@@ -897,7 +902,7 @@ fn robust_to_decimation_spikes_clock_offset_and_drift() {
     use rocklab::reduce::{physics, read_log};
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/campaigns/one-sided-demo");
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(&dir);
     for id in ["150_2", "100_1"] {
         let spec = campaign.tests.iter().find(|t| t.id == id).unwrap();
         let log = read_log(spec).unwrap();
@@ -1022,7 +1027,7 @@ fn accuracy_table() {
         ] {
             let dir = fixture_dir(name);
             let campaign = load_campaign(name, unstated);
-            let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+            let truth = truth_in(&dir);
             let res = reduce_campaign(
                 campaign,
                 PeakOptions {
@@ -1065,7 +1070,7 @@ fn engine_report(dir: &Path, name: &str) -> Vec<ReportRow> {
 fn engine_reduction(dir: &Path, name: &str) -> (rocklab::reduce::CampaignResult, Vec<ReportRow>) {
     let campaign = Campaign::load(&dir.join("campaign.toml")).unwrap();
     let e_h = campaign.e_housner;
-    let truth: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let truth = truth_in(dir);
     let res = reduce_campaign(campaign, PeakOptions::default());
     let mut out = Vec::new();
     for t in &res.tests {

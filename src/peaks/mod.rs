@@ -980,12 +980,23 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             c
         })
     };
+    // What the passes below share: the local re-fits of the arcs' ends, the
+    // late readings and whether the contact model may re-read the pushes.
+    let local = quality::local_peaks(&fit, n_peaks, p.sigma);
+    // One-sided walls: no local reading vouches (vouch.rs, "Not on one-sided walls").
+    let late = || {
+        if phys.rocking == Rocking::OneSided {
+            return Vec::new();
+        }
+        late_readings(t, &p, phys, &fit, n_peaks)
+    };
+    let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
     // A two-sided fit that misses the log smoothly and for no other reason
     // (judged with the fit's own u) is read again with its model-form terms
     // uncorrelated, the misfit its note ([`CarriedMisfit`]).
     let carriable = CarriedMisfit::of(&fit, &resid, phys, p.sigma);
     let mut carried = false;
-    let (peaks, cov, methods, local, model_note, deferred_reason, deferred_misfit, verdict) = loop {
+    let (peaks, cov, methods, model_note, deferred_reason, deferred_misfit, verdict) = loop {
         let misfit = misfit.clone();
         let tried = misfit.is_some() || carried;
         let mut cov = build_cov(tried);
@@ -1018,17 +1029,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             .collect();
         // Per impact: the local reading where the log resolves a smooth extreme.
         let methods = local::choose(&fit, &mut peaks, cov.as_mut(), p.dt, p.sigma);
-        let local = quality::local_peaks(&fit, n_peaks, p.sigma);
-        // One-sided walls: no local reading vouches (vouch.rs, "Not on one-sided walls").
-        let late = || {
-            if phys.rocking == Rocking::OneSided {
-                return Vec::new();
-            }
-            late_readings(t, &p, phys, &fit, n_peaks)
-        };
         // A push whose zero readings disagree is a reason only if the contact
         // model does not read the pushes (`inward`, after this fit): deferred.
-        let pushes_rereadable = phys.rocking == Rocking::OneSided && unfiltered_contacts(&fit);
         let (spread_checked, deferred_reason) = if pushes_rereadable {
             let pick = |push: bool| -> Vec<f64> {
                 let global = |k: usize| methods.get(k) != Some(&ReadingMethod::LocalExtreme);
@@ -1086,7 +1088,7 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             carried = true;
             continue;
         }
-        break (peaks, cov, methods, local, model_note, deferred_reason, deferred_misfit, verdict);
+        break (peaks, cov, methods, model_note, deferred_reason, deferred_misfit, verdict);
     };
     Ok(Analysis {
         release_time_s: fit.model().release_time(),

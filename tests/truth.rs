@@ -293,14 +293,17 @@ fn relative_u(r: &rocklab::reduce::Reduced, k: usize) -> f64 {
 /// the same undetermined exit). A push whose global own u exceeds 20 % of its
 /// speed now carries the contact reading's u alone, with the contact model's
 /// 1 % form: ok, each push within 2 % u, every value within 1 pp (measured
-/// 0.62 pp) and 2 u.
+/// 0.62 pp) and 2 u. Since the forty-fifth session a replaced push carries
+/// the form the contact readings of a test share too (1.4 %,
+/// `peaks::inward::SHARED_FORM`): each push within 2.5 % u (1 % and 1.4 %
+/// in quadrature are 1.72 %, beside the reading's own u).
 #[test]
 fn pushes_the_global_fit_does_not_read_carry_the_contact_readings_u() {
     let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-undetermined-pushes");
     let r = res.tests[0].result.as_ref().unwrap();
     for k in [1, 3, 5] {
         let u = relative_u(r, k);
-        assert!(u < 0.02, "peak {k} at ± {:.1} %", 100.0 * u);
+        assert!(u < 0.025, "peak {k} at ± {:.1} %", 100.0 * u);
     }
     assert_values_within(r, &truth, "Q1_170_1", 0.01);
 }

@@ -265,8 +265,8 @@ pub struct Analysis {
     pub peak_covariance: Option<Vec<Vec<f64>>>,
     /// The global fit's own part of `peak_covariance`: s²(JᵀJ)⁻¹ with the
     /// directions the log only bounds, before the model-form terms. Where
-    /// [`inward`] reads a peak on its own, this part is the global fit's and
-    /// is swapped for the local reading's.
+    /// [`inward`] reads a peak on its own, this part tells whether the global
+    /// fit determined that peak at all.
     pub fit_covariance: Option<Vec<Vec<f64>>>,
     /// Whether the fit chose finite-duration contacts (see [`model`]).
     pub contact_phases: bool,

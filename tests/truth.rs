@@ -265,7 +265,8 @@ fn the_pushes_peaks_are_read_by_the_contact_model() {
 /// 2 u of the truth (measured worst 0.66 pp, r₁). Since the twenty-fifth
 /// session a push whose global own u exceeds 20 % of its speed carries the
 /// contact reading's u alone (with the contact model's 1 % form): ± 1.05 %
-/// (measured; its error −1.7 %).
+/// (measured; its error −1.7 %); since the forty-fifth session with the form
+/// a test's contact readings share (1.4 %) too: ± 1.96 % (measured).
 #[test]
 fn a_push_the_global_fit_does_not_determine_is_read_by_the_contact_model() {
     let (res, truth) = ok_with_pushes_read_by_the_contact_model("mujoco-one-sided-undetermined-exit");

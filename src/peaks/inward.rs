@@ -638,13 +638,16 @@ mod tests {
         apply(a, &new);
     }
 
-    /// The global reading's u, its model-form terms included, does not
-    /// carry over to the contact reading that replaces it: a global peak
-    /// read to ± 13 % (peak 3, √(16 + 1500)) is replaced by a reading whose u
-    /// is its own, the disagreement's and the shared form's.
+    /// The global reading's model-form terms do not carry over to the
+    /// contact reading that replaces it: a global peak read to ± 13 % by
+    /// its model-form terms (peak 3: u² = 1516, its own part 9) is replaced
+    /// by a reading whose u is its own, the disagreement's and the shared
+    /// form's.
     #[test]
     fn the_global_readings_terms_do_not_carry_over() {
-        let mut a = with_own_part(1500.0);
+        let mut a = with_own_part(9.0);
+        a.peak_covariance.as_mut().unwrap()[3][3] = 1516.0;
+        a.peaks[3].velocity_u_mm_s = Some(1516f64.sqrt());
         replace_at_the_noise(&mut a, [408.0, 303.0, 221.0]);
         // Peak 3: 1 + 3.03² (own and form), 3²/3 (the disagreement), (0.014 × 303)².
         let u3_sq = 1.0 + 3.03f64.powi(2) + 3.0 + 4.242f64.powi(2);

@@ -203,6 +203,17 @@ pub enum PeakError {
         "the log starts {0:.2} mm on the inward side of its final rest level: expected a release from an outward displacement (check outward_sign)"
     )]
     InwardStart(f64),
+    #[error(
+        "the log ends while the wall still moves: its last {tail_s:.2} s spread {spread_mm:.2} mm (RMS) about their mean, {ratio:.0} × the noise ({noise_mm:.3} mm) and {share:.0} % of the release's displacement; the zero of θ is the wall at rest after the motion, so the log must run until the wall is still",
+        ratio = spread_mm / noise_mm,
+        share = 100.0 * share
+    )]
+    NoFinalRest {
+        tail_s: f64,
+        spread_mm: f64,
+        noise_mm: f64,
+        share: f64,
+    },
     #[error("too few peaks (n = {found} < {needed}): the rocking after release shows only {found} reliable half-cycles above the noise")]
     TooFewPeaks { found: usize, needed: usize },
     #[error("the fit of the free-rocking segments failed: only {0} samples in the rocking window")]
@@ -549,6 +560,10 @@ fn prepare_log(t: &[f64], x: &[f64], n_peaks: usize) -> Result<Prepared, PeakErr
     // phases there. The spikes of the random draws are 20–80 σ.
     let spikes = prepare::remove_isolated_spikes(&mut x, 12.0 * sigma);
     let dt = median(&t.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+    // Said in place of "too few peaks" where the log has too few crossings
+    // because it ends while the wall still rocks (the zero below is then
+    // taken through the motion).
+    let moving = prepare::still_moving_at_the_end(t, &x, sigma);
     // The sensor's zero drifts: the line through the final rest is the zero of θ
     // at every time. Subtracting it makes the rest level 0 and removes a linear
     // drift.
@@ -571,10 +586,10 @@ fn prepare_log(t: &[f64], x: &[f64], n_peaks: usize) -> Result<Prepared, PeakErr
     })?;
     let crossings = crossings::find_crossings(t, &x, 0.0, sigma, departure, n_peaks + 1);
     if crossings.len() < n_peaks {
-        return Err(PeakError::TooFewPeaks {
+        return Err(moving.unwrap_or(PeakError::TooFewPeaks {
             found: crossings.len(),
             needed: n_peaks,
-        });
+        }));
     }
     let beside_impacts = beside_impacts(t, &spikes, &crossings, dt);
     Ok(Prepared {

@@ -1356,6 +1356,30 @@ fn a_log_that_ends_while_the_wall_rocks_is_refused_for_that() {
     );
 }
 
+/// A two-sided contact fit whose minimum the log leaves open (forty-sixth
+/// session, `peaks::segments::restart_window`): the 100 Hz test H2_80_1 of
+/// `mujoco-holdout-two-sided-s4414` (`--preset holdout-two-sided --seed
+/// 4414`, forty-fourth session) was ok with r, r⁺ and r⁻ 1.03–1.50 pp off at
+/// u 0.07–0.09 pp and 5 of its 6 peaks more than 2 u off (83 % of the
+/// campaign's ok peaks within 2 u). Its contact fit starts from one window
+/// (2Δt = 20 ms) and stops in a minimum that fits from 1Δt and 3Δt go below,
+/// with peaks 3.5–9.3 % lower. Those restarts' peaks now widen its u, the
+/// chosen fit staying. Asserted: at most one test flagged, H2_80_1 ok with
+/// every peak within 2 u, and ≥ 90 % of the campaign's ok peaks within 2 u
+/// (measured: none flagged, 100 %; H2_80_1 still 1.50 pp off, within its u,
+/// so the campaign misses issue 18's 1.0 pp).
+#[test]
+fn a_contact_fit_minimum_the_log_leaves_open_widens_u() {
+    let name = "mujoco-holdout-two-sided-s4414";
+    let (_, rep) = engine_reduction(&fixture_dir(name), name);
+    let (flagged, _, within) = summary_of(name, &rep);
+    assert!(flagged <= 1, "{flagged} tests flagged");
+    let r = rep.iter().find(|r| r.0 == "H2_80_1").expect("H2_80_1");
+    assert!(r.2, "H2_80_1 flagged");
+    assert!(r.3.iter().all(|&z| z <= 2.0), "H2_80_1's peaks in u: {:?}", r.3);
+    assert!(within >= 0.9, "{within:.2} of the ok peaks within 2 u");
+}
+
 /// A two-sided fit that misses the log smoothly and for no other reason
 /// (`peaks::CarriedMisfit`, forty-fourth session): the 70 mm test of
 /// `mujoco-holdout-two-sided-s3504` (`--preset holdout-two-sided --seed

@@ -187,6 +187,9 @@ impl SegmentFit {
         if one_sided && contacts {
             (chosen, rival_minimum) = restart_damping(chosen, &tw, &yw, extra * n.ln() * sigma2);
         }
+        if !one_sided && contacts && estimated.is_none() && windows.len() == 1 {
+            rival_minimum = restart_window(&simple.model, &chosen, dt, &tw, &yw, extra * n.ln() * sigma2);
+        }
         Ok(SegmentFit {
             rms: (chosen.fit.cost / n).sqrt(),
             fitted: chosen,
@@ -471,6 +474,35 @@ fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted,
         .max_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, p)| p);
     (best, rival)
+}
+
+/// The starting windows of [`restart_window`], in sampling steps Δt: one
+/// narrower and one wider than the single start 2Δt of a log at 200 Hz or
+/// less.
+const RESTART_WINDOWS: [f64; 2] = [1.0, 3.0];
+
+/// A two-sided contact fit `chosen` that started from one window (2Δt ≥ 10
+/// ms: 200 Hz or less) against the same contact model started from
+/// [`RESTART_WINDOWS`]: the peaks of the restart that differ most from the
+/// chosen fit's, among those whose cost is at most `evidence` above the chosen
+/// fit's (any lower one included), as a second minimum for the u
+/// ([`restart_damping`]'s rival). The chosen fit stays: at 100 Hz the lower
+/// minima have wider contacts that the checks cannot vouch for (forty-fourth
+/// session, docs/accuracy.md), but a log that leaves the minimum open does not
+/// pin the peaks either.
+fn restart_window(plain: &Model, chosen: &Fitted, dt: f64, tw: &[f64], yw: &[f64], evidence: f64) -> Option<Vec<f64>> {
+    let m = chosen.model.m();
+    let mine: Vec<f64> = (0..m).map(|k| chosen.model.peak(k).1).collect();
+    RESTART_WINDOWS
+        .iter()
+        .filter_map(|&w| fit_model(plain.with_contacts(w * dt), tw, yw, 100))
+        .filter(|f| f.fit.cost - chosen.fit.cost <= evidence)
+        .map(|f| (0..m).map(|k| f.model.peak(k).1).collect::<Vec<f64>>())
+        .filter(|p| !gains_energy(p))
+        .map(|p| (p.iter().zip(&mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
+        .filter(|(d, _)| d.is_finite() && *d > 0.0)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, p)| p)
 }
 
 /// Whether a fit's peaks (all the model's) read the wall gaining energy: a

@@ -229,7 +229,7 @@ mod tests {
     }
 
     /// Rocking at ± 20 mm when the log ends (13 % of the release): said so.
-    /// At rest (the same log long after the motion has died out: 10⁻¹³ mm)
+    /// At rest (a decay time of 1 s: below 10⁻¹³ mm when the log ends)
     /// and with a late wobble of 1 % of the release (1.5 mm), not.
     #[test]
     fn a_log_that_ends_while_the_wall_rocks_is_said_to() {

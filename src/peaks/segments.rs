@@ -466,14 +466,24 @@ fn restart_damping(f: Fitted, tw: &[f64], yw: &[f64], evidence: f64) -> (Fitted,
         0
     };
     let (best, mine) = read.swap_remove(chosen);
-    let rival = read
-        .into_iter()
-        .filter(|(f, p)| f.fit.cost - best.fit.cost <= evidence && credible(p))
-        .map(|(_, p)| (p.iter().zip(&mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
+    let rival = widest_rival(
+        read.into_iter()
+            .filter(|(f, p)| f.fit.cost - best.fit.cost <= evidence && credible(p))
+            .map(|(_, p)| p),
+        &mine,
+    );
+    (best, rival)
+}
+
+/// Of the `rivals`' peaks, those that differ most from `mine` (the largest
+/// |difference| of a peak), where they differ at all: the second minimum
+/// that widens u ([`restart_damping`], [`restart_window`]).
+fn widest_rival(rivals: impl Iterator<Item = Vec<f64>>, mine: &[f64]) -> Option<Vec<f64>> {
+    rivals
+        .map(|p| (p.iter().zip(mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
         .filter(|(d, _)| d.is_finite() && *d > 0.0)
         .max_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, p)| p);
-    (best, rival)
+        .map(|(_, p)| p)
 }
 
 /// The starting windows of [`restart_window`], in sampling steps Δt: one
@@ -493,16 +503,13 @@ const RESTART_WINDOWS: [f64; 2] = [1.0, 3.0];
 fn restart_window(plain: &Model, chosen: &Fitted, dt: f64, tw: &[f64], yw: &[f64], evidence: f64) -> Option<Vec<f64>> {
     let m = chosen.model.m();
     let mine: Vec<f64> = (0..m).map(|k| chosen.model.peak(k).1).collect();
-    RESTART_WINDOWS
+    let restarts = RESTART_WINDOWS
         .iter()
         .filter_map(|&w| fit_model(plain.with_contacts(w * dt), tw, yw, 100))
         .filter(|f| f.fit.cost - chosen.fit.cost <= evidence)
         .map(|f| (0..m).map(|k| f.model.peak(k).1).collect::<Vec<f64>>())
-        .filter(|p| !gains_energy(p))
-        .map(|p| (p.iter().zip(&mine).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max), p))
-        .filter(|(d, _)| d.is_finite() && *d > 0.0)
-        .max_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, p)| p)
+        .filter(|p| !gains_energy(p));
+    widest_rival(restarts, &mine)
 }
 
 /// Whether a fit's peaks (all the model's) read the wall gaining energy: a

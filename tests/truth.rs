@@ -1366,7 +1366,7 @@ fn a_log_that_ends_while_the_wall_rocks_is_refused_for_that() {
 /// with peaks 3.5–9.3 % lower. Those restarts' peaks now widen its u, the
 /// chosen fit staying. Asserted: at most one test flagged, H2_80_1 ok with
 /// every peak within 2 u, and ≥ 90 % of the campaign's ok peaks within 2 u
-/// (measured: none flagged, 100 %; H2_80_1 still 1.50 pp off, within its u,
+/// (measured: none flagged, 100 %; H2_80_1's r⁺ still 1.50 ± 0.63 pp off,
 /// so the campaign misses issue 18's 1.0 pp).
 #[test]
 fn a_contact_fit_minimum_the_log_leaves_open_widens_u() {

@@ -570,7 +570,7 @@ fn prepare_log(t: &[f64], x: &[f64], n_peaks: usize) -> Result<Prepared, PeakErr
     prepare::detrend_by_final_rest(t, &mut x, sigma);
     // The log starts with the wall held at its imposed displacement: its first
     // samples (25, or a tenth of a short log) give the hold level.
-    let hold = median(&x[..(n / 10).clamp(5, 25)]);
+    let hold = prepare::hold_level(&x);
     if hold.abs() < 20.0 * sigma {
         return Err(PeakError::NoRelease {
             amplitude_mm: hold.abs(),

@@ -54,7 +54,7 @@ pub(super) fn remove_isolated_spikes(x: &mut [f64], threshold: f64) -> Vec<usize
 /// off by centimetres.
 pub(super) fn detrend_by_final_rest(t: &[f64], x: &mut [f64], sigma: f64) {
     let n = t.len();
-    let tail = (n * 5 / 100).max(5).min(n);
+    let tail = final_rest_len(n);
     let (m0, s0) = line_fit(&t[n - tail..], &x[n - tail..]);
     let t_ref = t[n - tail];
     // The last excursion: three samples in a row beyond 6 σ (a spike the cleaner
@@ -85,8 +85,20 @@ pub(super) fn detrend_by_final_rest(t: &[f64], x: &mut [f64], sigma: f64) {
 /// How far the final rest may spread about its mean (RMS) before the log is
 /// said not to end at rest: [`STILL_NOISE`] × σ and [`STILL_SHARE`] of the
 /// release's displacement (both: a noisy rest or a small late wobble passes).
-pub(super) const STILL_NOISE: f64 = 20.0;
-pub(super) const STILL_SHARE: f64 = 0.02;
+const STILL_NOISE: f64 = 20.0;
+const STILL_SHARE: f64 = 0.02;
+
+/// The samples the final rest is first read from: the last 5 % of a log of
+/// `n` (at least 5, at most all).
+fn final_rest_len(n: usize) -> usize {
+    (n * 5 / 100).max(5).min(n)
+}
+
+/// The level of the initial hold: the median of the first samples (25, or a
+/// tenth of a short log, at least 5).
+pub(super) fn hold_level(x: &[f64]) -> f64 {
+    median(&x[..(x.len() / 10).clamp(5, 25).min(x.len())])
+}
 
 /// A log that ends while the wall still rocks: the RMS spread of its last 5 %
 /// (the samples [`detrend_by_final_rest`] starts from) about their mean above
@@ -105,12 +117,11 @@ pub(super) const STILL_SHARE: f64 = 0.02;
 /// analysed as before.
 pub(super) fn still_moving_at_the_end(t: &[f64], x: &[f64], sigma: f64) -> Option<super::PeakError> {
     let n = t.len();
-    let tail = (n * 5 / 100).max(5).min(n);
+    let tail = final_rest_len(n);
     let (tt, xt) = (&t[n - tail..], &x[n - tail..]);
     let level = xt.iter().sum::<f64>() / tail as f64;
     let spread = (xt.iter().map(|xi| (xi - level).powi(2)).sum::<f64>() / tail as f64).sqrt();
-    let hold = median(&x[..(n / 10).clamp(5, 25).min(n)]);
-    let share = spread / (hold - level).abs().max(f64::MIN_POSITIVE);
+    let share = spread / (hold_level(x) - level).abs().max(f64::MIN_POSITIVE);
     (spread > STILL_NOISE * sigma && share > STILL_SHARE).then(|| super::PeakError::NoFinalRest {
         tail_s: tt[tail - 1] - tt[0],
         spread_mm: spread,

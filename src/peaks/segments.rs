@@ -187,7 +187,8 @@ impl SegmentFit {
         if one_sided && contacts {
             (chosen, rival_minimum) = restart_damping(chosen, &tw, &yw, extra * n.ln() * sigma2);
         }
-        if !one_sided && contacts && estimated.is_none() && windows.len() == 1 {
+        // (An estimated filter has set `contacts` false above.)
+        if !one_sided && contacts && windows.len() == 1 {
             rival_minimum = restart_window(&simple.model, &chosen, dt, &tw, &yw, extra * n.ln() * sigma2);
         }
         Ok(SegmentFit {

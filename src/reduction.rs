@@ -197,7 +197,10 @@ pub fn shows_contacts(with: usize, voters: usize) -> bool {
 /// (tests with contact phases, tests that vote) of [`campaign_shows_contacts`],
 /// majority or not.
 pub fn contact_votes<'a>(analyses: impl IntoIterator<Item = &'a Analysis>) -> (usize, usize) {
-    let voters: Vec<&Analysis> = analyses.into_iter().filter(|a| votes(a) && a.response.source != "estimated").collect();
+    let voters: Vec<&Analysis> = analyses
+        .into_iter()
+        .filter(|a| votes(a) && a.response.source != "estimated" && a.wide_rounding_read_as_contacts.is_none())
+        .collect();
     (voters.iter().filter(|a| a.contact_phases).count(), voters.len())
 }
 

@@ -139,8 +139,10 @@ fn random_rigid_tests_full_draw() {
 }
 
 /// 200 tests with finite-duration lossy contacts (the compliant generator): none
-/// more than 5 pp off with status ok. Measured 80.5 % ok within 1 pp, 24
-/// flagged, worst ok 1.78 pp (draw 1018; docs/acquisition.md). The success rate is
+/// more than 5 pp off with status ok. Measured 82.0 % ok within 1 pp, 23
+/// flagged, worst ok 1.76 pp (forty-seventh session, a wide and widening
+/// rounding read as the contacts': 80.5 %, 25 flagged before; 24 flagged and
+/// 1.78 pp, draw 1018, when written; docs/acquisition.md). The success rate is
 /// printed, asserted only above 55 %: this family is where the estimator's
 /// contact model is still weak. On the seeds `DRAW_SEED_OFFSET=200000` one test
 /// is ok 5.60 pp off (201145: a wide-rounding filter estimate and the contact
@@ -168,6 +170,12 @@ fn run_logged(seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) -> Ve
     run_logged_seeds(&fresh(seeds).collect::<Vec<_>>(), kind, stated)
 }
 
+/// [`run_logged`] with the wall's contacts drawn from `family` (the rigid
+/// draws above; compliant walls behind a logger below).
+fn run_logged_walls(family: Family, seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) -> Vec<Scored> {
+    run_logged_family(family, &fresh(seeds).collect::<Vec<_>>(), kind, stated)
+}
+
 /// `seeds` shifted by `DRAW_SEED_OFFSET` (module docs; 0 when unset).
 fn fresh(seeds: std::ops::Range<u64>) -> std::ops::Range<u64> {
     let offset: u64 = match std::env::var("DRAW_SEED_OFFSET") {
@@ -179,11 +187,16 @@ fn fresh(seeds: std::ops::Range<u64>) -> std::ops::Range<u64> {
 
 /// [`run_logged`] over the draws `seeds`.
 fn run_logged_seeds(seeds: &[u64], kind: LoggerDraw, stated: bool) -> Vec<Scored> {
+    run_logged_family(Family::Rigid, seeds, kind, stated)
+}
+
+/// [`run_logged_seeds`] for walls of `family`.
+fn run_logged_family(family: Family, seeds: &[u64], kind: LoggerDraw, stated: bool) -> Vec<Scored> {
     seeds
         .par_iter()
         .copied()
         .map(|s| {
-            let (syn, logger) = draw_logged(s, Family::Rigid, kind);
+            let (syn, logger) = draw_logged(s, family, kind);
             let acquisition = match (stated, logger.stated(syn.spec.fs_hz)) {
                 (true, Some(lp)) => Acquisition::Stated(lp),
                 _ => Acquisition::Unknown,
@@ -309,6 +322,71 @@ fn unstated_causal_families_full_draw() {
     assert!(rate >= 0.98, "success rate {rate}");
 }
 
+/// Compliant walls behind a logger: both things a real lab has at once (the
+/// compliant generator's walls, [`run`] with `Family::Compliant`, logged as
+/// the rigid draws above). Asserted as the compliant family without a
+/// filter is ([`random_compliant_tests_full_draw`]): none ok and more than
+/// 5 pp off, at least 55 % ok within 1 pp. Measured (forty-seventh session,
+/// 200 tests each; docs/acquisition.md, "So wide a rounding, widening, is
+/// read as the contacts'"), ok within 1 pp / ok more than 2 pp off: stated Bessel
+/// 0.10–0.40 f_s 80.5 % / 2; unstated Bessel 0.25–0.40 f_s 85.0 % / 2 (84.0 %
+/// / 6 while an estimated low-pass below 0.25 f_s, its rounding widening, was
+/// the value); unstated FIR 79.5 % / 1.
+fn compliant_behind_a_logger(name: &str, seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) {
+    let scored = run_logged_walls(Family::Compliant, seeds, kind, stated);
+    let (rate, _) = summarise_logged(name, &scored);
+    let silent = scored
+        .iter()
+        .filter(|s| s.status.starts_with("ok ") && s.worst_pp.as_ref().is_ok_and(|w| *w > 5.0))
+        .count();
+    assert_eq!(silent, 0, "{name}: a test more than 5 pp off was reported ok");
+    assert!(rate >= 0.55, "{name}: success rate {rate}");
+}
+
+/// [`compliant_behind_a_logger`], the Bessel stated.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn compliant_walls_behind_a_stated_bessel_full_draw() {
+    compliant_behind_a_logger("compliant stated bessel", 7000..7200, bessel(0.10, 0.40), true);
+}
+
+/// [`compliant_behind_a_logger`], the Bessel not stated.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn compliant_walls_behind_an_unstated_bessel_full_draw() {
+    compliant_behind_a_logger("compliant unstated bessel", 7200..7400, bessel(0.25, 0.40), false);
+}
+
+/// [`compliant_behind_a_logger`], an unstated FIR.
+#[test]
+#[ignore = "full logged draw: run in release (docs/acquisition.md)"]
+fn compliant_walls_behind_an_unstated_fir_full_draw() {
+    compliant_behind_a_logger("compliant unstated fir", 7400..7600, LoggerDraw::Fir, false);
+}
+
+/// Compliant walls behind an unstated Bessel (0.25–0.40 f_s, draws of
+/// [`compliant_walls_behind_an_unstated_bessel_full_draw`]) whose estimated
+/// low-pass came out below 0.25 f_s (0.16–0.22 f_s: the filter and the
+/// contacts' rounding together) and whose peaks, read through it, grew
+/// +1.3 … +21 % from peak to peak: ok 2.38, 3.35, 2.42 and 2.46 pp off. Read
+/// with contact phases and no filter (`peaks::contacts_for_a_wide_rounding`:
+/// their rounding widens over the later impacts), measured: 0.85, 1.32, 1.11
+/// and 0.61 pp. Asserted: none
+/// ok and more than 2 pp off (issue 18's bound for a logged test), and each
+/// one's note says that the rounding was read as the contacts'.
+#[test]
+fn compliant_walls_once_read_through_a_wide_filter() {
+    let kind = bessel(0.25, 0.40);
+    let scored = run_logged_family(Family::Compliant, &[7280, 7290, 7308, 7351], kind, false);
+    for s in &scored {
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        println!("draw {}: {w:.2} pp [{}]", s.seed, s.status);
+        assert!(!s.status.starts_with("ok ") || w <= 2.0, "draw {}: {w:.2} pp, {}", s.seed, s.status);
+        let note = s.acquisition_note.as_deref().unwrap_or_default();
+        assert!(note.contains("as a compliant contact's are"), "draw {}: {note:?}", s.seed);
+    }
+}
+
 /// The unstated-FIR draws that were ok but 1.0–1.9 pp off before the FIR was
 /// modelled (draw indices of `unstated_fir_full_draw`).
 #[test]
@@ -396,17 +474,27 @@ fn compliant_tests_once_taken_for_a_filter() {
 }
 
 /// A compliant test whose unstated filter cannot be told from its contacts is
-/// flagged, and says to state the filter: the compliant draw's seed 1178
-/// (200 Hz, κ = 0.55 p²): an estimated Bessel 4 at 43.8 Hz against contact
-/// phases that fit better and whose ratios differ by 0.018, the rounding
-/// widening over the later impacts; 1.27 pp off (full draw, session 16).
+/// flagged, and says to state the filter: the compliant draw's seed 1064
+/// (100 Hz, κ = 21.8 p²): an estimated Bessel 4 at 63.9 Hz (0.64 f_s) against
+/// contact phases that fit better and whose ratios differ by 0.070, the
+/// rounding widening over the later impacts; 1.24 pp off (forty-seventh
+/// session). Seed 1178 was this test's case until then (200 Hz, κ = 0.55 p²:
+/// a Bessel 4 at 43.8 Hz, 0.22 f_s, suspect 1.28 pp off); a rounding that
+/// wide is now read as the contacts' (`peaks::contacts_for_a_wide_rounding`),
+/// and it is ok within 1 pp (measured 0.53 pp), which is asserted too.
 #[test]
 fn a_filter_that_cannot_be_told_from_the_contacts_is_flagged() {
     use rocklab::report::quality::{kind, split, Kind};
-    let s = score(&draw(1178, Family::Compliant));
+    let s = score(&draw(1064, Family::Compliant));
     let why = s.status.strip_prefix("suspect: ").unwrap_or_else(|| panic!("not suspect: {}", s.status));
     assert!(split(why).into_iter().map(kind).any(|k| k == Kind::FilterUnknown), "{why}");
     assert!(why.contains("state the filter"), "{why}");
+    let wide = score(&draw(1178, Family::Compliant));
+    let w = wide.worst_pp.clone().unwrap_or(f64::INFINITY);
+    println!("seed 1178: {w:.2} pp [{}]", wide.status);
+    assert!(wide.status == "ok" && w <= 1.0, "seed 1178: {w:.2} pp, {}", wide.status);
+    let note = wide.acquisition_note.as_deref().unwrap_or_default();
+    assert!(note.contains("a compliant contact's"), "seed 1178: {note:?}");
 }
 
 /// The tests of the full draws that were ok but more than 2 pp off before the

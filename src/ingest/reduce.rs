@@ -289,10 +289,10 @@ fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: V
     };
     for t in tests.iter_mut() {
         let Ok(r) = &t.result else { continue };
-        if r.analysis.contact_phases {
-            continue;
-        }
-        let again = reduce_loaded(campaign, &t.spec, r.log.clone(), &expected);
+        // A log read with contact phases for a wide rounding
+        // (`peaks::contacts_for_a_wide_rounding`) carries its estimated filter's
+        // reading in u: the campaign's contacts rule that filter out below.
+        let flipped = r.analysis.wide_rounding_read_as_contacts.clone();
         // A reading with contact phases that is sound but for a one-sided wall's
         // excursions spanning too few samples (`checks::inward_arcs_unresolved`)
         // is taken too: the test stays suspect for that, with the wall's contacts.
@@ -301,17 +301,23 @@ fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: V
                 .as_ref()
                 .is_ok_and(|n| n.analysis.contact_phases && n.analysis.quality.is_ok_but_for_short_inward_arcs())
         };
-        if fits(&again) {
-            t.result = again.result;
-            t.warnings.push(format!(
-                "contact phases fitted because {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show them; this log alone did not ask for them"
-            ));
-            continue;
+        if flipped.is_none() {
+            if r.analysis.contact_phases {
+                continue;
+            }
+            let again = reduce_loaded(campaign, &t.spec, r.log.clone(), &expected);
+            if fits(&again) {
+                t.result = again.result;
+                t.warnings.push(format!(
+                    "contact phases fitted because {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show them; this log alone did not ask for them"
+                ));
+                continue;
+            }
         }
         // A compliant contact rounds an impact as a logger's low-pass does: where the
         // wall's other tests show contacts and this one's filter was only estimated
         // (never stated), the rounding is read as the wall's contacts.
-        if t.spec.acquisition != crate::peaks::acquisition::Acquisition::Unknown || r.analysis.response.source != "estimated" {
+        if t.spec.acquisition != crate::peaks::acquisition::Acquisition::Unknown || (r.analysis.response.source != "estimated" && flipped.is_none()) {
             continue;
         }
         let unfiltered = PeakOptions {
@@ -322,7 +328,7 @@ fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: V
             acquisition: crate::peaks::acquisition::Acquisition::None,
             ..t.spec.clone()
         };
-        let estimated = estimated_filter(&r.analysis);
+        let estimated = flipped.clone().unwrap_or_else(|| estimated_filter(&r.analysis));
         let mut again = reduce_loaded(campaign, &spec, r.log.clone(), &unfiltered);
         if fits(&again) {
             if let Ok(n) = &mut again.result {
@@ -332,6 +338,10 @@ fn contacts_of_the_wall(campaign: &Campaign, options: &PeakOptions, mut tests: V
             t.warnings.push(format!(
                 "contact phases fitted instead of an estimated logger filter because {with} of the campaign's {n_ok} tests that can tell (status ok or only ratios read loosely, no estimated filter) show them (a compliant contact rounds an impact as a low-pass does); state the filter in the manifest if the logger had one"
             ));
+            continue;
+        }
+        // A log read with contact phases already keeps that reading.
+        if flipped.is_some() {
             continue;
         }
         // Neither reading is vouched for: the campaign says the rounding is the

@@ -384,7 +384,7 @@ pub enum Generic {
 }
 
 impl Generic {
-    fn lowpass(self, fc: f64) -> LowPass {
+    pub(super) fn lowpass(self, fc: f64) -> LowPass {
         let (family, order) = match self {
             Generic::Butterworth4 => (Family::Butterworth, 4),
             Generic::Butterworth2 => (Family::Butterworth, 2),
@@ -600,6 +600,22 @@ pub struct Trend {
 }
 
 impl Trend {
+    /// The later impacts are rounded more widely than the earlier ones by more
+    /// than 3 of the trend's u (d < −3u), with no floor on the size or the gain
+    /// that [`Trend::widens`] asks before it drops a filter: enough, for a
+    /// rounding already as wide as a compliant contact's ([`WIDE_ROUNDING`]),
+    /// to read it as the contacts' (`peaks::contacts_for_a_wide_rounding`).
+    /// Measured (forty-seventh session, estimates below 0.25 f_s whose
+    /// contact-phase reading passed its checks): rigid walls behind an
+    /// unstated causal low-pass at 0.10–0.45 f_s, 1 of 66 at −3u or lower
+    /// (d/u −4.1, both readings within 1 pp; below −2u, 2: the other at −2.5u,
+    /// whose worst ratio the contacts read 2.44 pp off, the filter 0.50);
+    /// compliant walls behind an unstated Bessel, 8 of 43, the contacts'
+    /// reading the closer on 7.
+    pub fn widening(&self) -> bool {
+        self.d_ln_fc < -WIDENING_SIGMAS * self.u
+    }
+
     /// The later impacts are rounded more widely than the estimated response
     /// rounds the earlier ones, beyond doubt: a cut-off at least 10 % lower
     /// (ln ratio < −0.1), 3 u below, and the data ask for the second cut-off
@@ -809,8 +825,14 @@ fn at_noise(f: &Fitted, n: f64, sigma2: f64) -> bool {
 /// with contact phases, 0.35–0.9 pp off) and the filter's r was 0.78–1.52 pp
 /// high, 2.2–4.1 of its u. The truth lay at or beyond the contacts' reading
 /// (about 1.0–1.5 of the difference d between the readings), so d is carried as
-/// one standard uncertainty, Σ += d dᵀ, not as the ends of a rectangle.
+/// one standard uncertainty, Σ += d dᵀ, not as the ends of a rectangle; and
+/// since the forty-seventh session the contacts' reading is the value where it
+/// passes its checks, the filter's in u (`peaks::contacts_for_a_wide_rounding`).
 pub const WIDE_ROUNDING: f64 = 0.25;
+
+/// How many of its u the later impacts' cut-off must lie below the earlier
+/// ones' for [`Trend::widening`].
+const WIDENING_SIGMAS: f64 = 3.0;
 
 /// The largest difference between two sets of peaks in the ratio of
 /// consecutive peaks (what the table values are made of).

@@ -491,11 +491,13 @@ mod tests {
                 fir_cutoff_hz: None,
             },
             acquisition_note: None,
+            wide_rounding_read_as_contacts: None,
             contact_readings: None,
             local_misfit: Vec::new(),
             model_note: None,
             deferred_reason: None,
             deferred_misfit: None,
+            wide_rounding: None,
         }
     }
 

@@ -163,6 +163,17 @@ pub(super) fn add_admissible_range(cov: &mut [Vec<f64>], e: &[f64]) {
     add_correlated(cov, e, 1.0);
 }
 
+/// Σ += d dᵀ over the peaks both have: `d` one standard uncertainty of every
+/// peak from one cause, fully correlated (a rival reading's difference,
+/// `peaks::contacts_for_a_wide_rounding`).
+pub(super) fn add_outer(cov: &mut [Vec<f64>], d: &[f64]) {
+    for (row, da) in cov.iter_mut().zip(d) {
+        for (c, db) in row.iter_mut().zip(d) {
+            *c += da * db;
+        }
+    }
+}
+
 /// Σ += w d dᵀ: a term whose parts share one cause (fully correlated).
 fn add_correlated(cov: &mut [Vec<f64>], d: &[f64], w: f64) {
     for (a, row) in cov.iter_mut().enumerate() {
@@ -176,6 +187,15 @@ fn add_correlated(cov: &mut [Vec<f64>], d: &[f64], w: f64) {
 mod tests {
     use super::*;
     use crate::peaks::Side;
+
+    /// d dᵀ is added over the peaks `d` has; the other rows and columns are
+    /// left as they were.
+    #[test]
+    fn an_outer_term_is_added_over_the_peaks_both_have() {
+        let mut cov = vec![vec![1.0, 0.0, 0.0], vec![0.0, 4.0, 0.0], vec![0.0, 0.0, 9.0]];
+        add_outer(&mut cov, &[2.0, -1.0]);
+        assert_eq!(cov, vec![vec![5.0, -2.0, 0.0], vec![-2.0, 5.0, 0.0], vec![0.0, 0.0, 9.0]]);
+    }
 
     /// The partly shared model-form term has the shared one's variances and
     /// smaller covariances (none where s² = 1/3): a same-side ratio's u then

@@ -167,18 +167,15 @@ pub(super) fn add_admissible_range(cov: &mut [Vec<f64>], e: &[f64]) {
 /// peak from one cause, fully correlated (a rival reading's difference,
 /// `peaks::contacts_for_a_wide_rounding`).
 pub(super) fn add_outer(cov: &mut [Vec<f64>], d: &[f64]) {
-    for (row, da) in cov.iter_mut().zip(d) {
-        for (c, db) in row.iter_mut().zip(d) {
-            *c += da * db;
-        }
-    }
+    add_correlated(cov, d, 1.0);
 }
 
-/// Σ += w d dᵀ: a term whose parts share one cause (fully correlated).
+/// Σ += w d dᵀ: a term whose parts share one cause (fully correlated), over
+/// the peaks `d` has.
 fn add_correlated(cov: &mut [Vec<f64>], d: &[f64], w: f64) {
-    for (a, row) in cov.iter_mut().enumerate() {
-        for (b, c) in row.iter_mut().enumerate() {
-            *c += w * d[a] * d[b];
+    for (row, da) in cov.iter_mut().zip(d) {
+        for (c, db) in row.iter_mut().zip(d) {
+            *c += w * da * db;
         }
     }
 }

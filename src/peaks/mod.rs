@@ -489,12 +489,13 @@ pub fn analyse(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions) -> Resu
 /// costs cannot say whose; a filter rounds every kink alike, a contact longer
 /// as the wall slows. With both (compliant walls behind an unstated Bessel at
 /// 0.25–0.40 f_s, 200 draws) the estimate fell at 0.16–0.22 f_s and the peaks
-/// read through it grew from peak to peak: ok more than 2 pp off 6 → 2, ok
-/// within 1 pp 84.0 → 85.0 %. Without the widening gate a real filter below
+/// read through it grew from peak to peak: ok more than 2 pp off 6 → 4, ok
+/// within 1 pp 84.0 → 84.5 %. Without the widening gate a real filter below
 /// 0.25 f_s on a rigid wall was read as contacts too (that draw 98.5 → 86.5 %,
-/// five ok more than 2 pp off); with it, unchanged seed for seed.
-/// docs/acquisition.md, "So wide a rounding, widening, is read as the
-/// contacts'".
+/// five ok more than 2 pp off); the gate asks 3 σ of the widening by its u and
+/// by its cost gain ([`acquisition::Trend::widening`]: with the u alone, three
+/// of 800 rigid draws were read 0.7–5.0 pp off as contacts). docs/acquisition.md,
+/// "So wide a rounding, widening, is read as the contacts'".
 fn contacts_for_a_wide_rounding(t: &[f64], x: &[f64], phys: &Physics, opts: &PeakOptions, filtered: Analysis) -> Analysis {
     let mut filtered = filtered;
     let Some(estimated) = filtered.wide_rounding.take() else {

@@ -394,9 +394,10 @@ fn compliant_walls_once_read_through_a_wide_filter() {
 /// [`unstated_causal_families_full_draw`], the fixed seeds and
 /// `DRAW_SEED_OFFSET=100000, 300000`) whose estimate's later impacts came out
 /// rounded more widely at 4.1, 3.0 and 4.0 u, but with cost gains of only 7.6,
-/// 5.9 and 6.4 σ²: read with contact phases in the forty-seventh session they
-/// were ok 0.69, 2.29 and 4.96 pp off (the contact model reading the
-/// filter's rounding). [`rocklab::peaks::acquisition::Trend::widening`] asks
+/// 5.9 and 6.4 σ²: read with contact phases in the forty-seventh session their
+/// worst ratio of consecutive peaks was 0.69, 3.33 and 4.96 pp off (the
+/// contact model reading the filter's rounding; 106078 was ok with a table
+/// value 2.29 pp off). [`rocklab::peaks::acquisition::Trend::widening`] asks
 /// the gain to exceed 9 σ² as well. Asserted: ok within 1 pp, the filter's
 /// reading kept (no note that reads the rounding as the contacts').
 #[test]

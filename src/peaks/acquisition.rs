@@ -616,7 +616,8 @@ impl Trend {
     /// 0.10–0.45 f_s, 213 such estimates over 800 draws (the fixed seeds and
     /// three fresh sets), 3 at d < −3u, each with a gain of 5.9–7.6 σ² only
     /// (the cost flatter than its curvature says), and read as contacts there
-    /// they were 0.69, 3.33 and 4.96 pp off where the filter read 0.02–0.52;
+    /// their worst ratio of consecutive peaks (over e_H) was 0.69, 3.33 and
+    /// 4.96 pp off where the filter's was 0.02–0.52;
     /// compliant walls behind an unstated Bessel, 9 of 53 at d < −3u, the
     /// contacts' reading the closer on 8, and 8 with a gain of 9.0–55 σ².
     pub fn widening(&self) -> bool {

@@ -115,6 +115,22 @@ fn fresh_draws_once_missed_are_reduced() {
     }
 }
 
+/// Idealised one-sided draws of the fresh seeds `DRAW_SEED_OFFSET=400000`
+/// (forty-ninth session) that were flagged for a u of ± 5.9–9.4 pp on r₁, read
+/// within 0.1 pp: a contact fit the log leaned towards (gain 12–20 σ²) read one
+/// side's peaks 15–21 % faster than the instantaneous fit, its quintic contact
+/// phases overshooting the arcs' speed within a sample, and was carried in u.
+/// A contact that sets in before θ = 0 can only brake the wall
+/// (`peaks::segments::LEANING_FASTER`): each is now ok and within 1 pp.
+#[test]
+fn fresh_draws_once_flagged_for_a_faster_contact_reading_are_reduced() {
+    for idx in [401006, 401235, 401341] {
+        let s = score(&draw(idx, Family::Rigid));
+        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
+        assert!(s.status == "ok" && w <= 1.0, "draw {idx}: {w} pp, {}", s.status);
+    }
+}
+
 /// 12 compliant draws: none silently wrong (the full draw gives the rate).
 #[test]
 fn random_compliant_tests_small_draw() {
@@ -127,8 +143,10 @@ fn random_compliant_tests_small_draw() {
 /// 100.0 % ok and within 1 pp since the exact arcs of Eq. 1 (fortieth
 /// session; 99.8 % before, one flagged), worst 0.86 pp; on the fresh seeds
 /// (`DRAW_SEED_OFFSET=100000`) 99.8 %, one flagged (6.2 pp off), worst ok
-/// 0.52 pp. No test more than 5 pp off with status ok. The bound is the
-/// issue's 99.5 %.
+/// 0.52 pp; on `DRAW_SEED_OFFSET=400000` 99.8 %, one flagged (401111, 0.49 pp
+/// off; 99.2 %, four flagged, before a leaning contact reading had to brake:
+/// forty-ninth session), worst ok 0.80 pp. No test more than 5 pp off with
+/// status ok. The bound is the issue's 99.5 %.
 #[test]
 #[ignore = "the full draw of issue #9: run in release (see the module docs)"]
 fn random_rigid_tests_full_draw() {
@@ -331,7 +349,8 @@ fn unstated_causal_families_full_draw() {
 /// read as the contacts'"), ok within 1 pp / ok more than 2 pp off: stated Bessel
 /// 0.10–0.40 f_s 80.5 % / 2; unstated Bessel 0.25–0.40 f_s 85.0 % / 2 (84.0 %
 /// / 6 while an estimated low-pass below 0.25 f_s, its rounding widening, was
-/// the value); unstated FIR 79.5 % / 1.
+/// the value); unstated FIR 79.5 % / 1. Forty-ninth session: 80.5 % / 2,
+/// 84.5 % / 4, 80.5 % / 1 (docs/accuracy.md, "Forty-ninth session").
 fn compliant_behind_a_logger(name: &str, seeds: std::ops::Range<u64>, kind: LoggerDraw, stated: bool) {
     let scored = run_logged_walls(Family::Compliant, seeds, kind, stated);
     let (rate, _) = summarise_logged(name, &scored);
@@ -439,6 +458,18 @@ fn fir_tests_once_missed_are_reduced() {
 #[test]
 fn stated_filter_tests_once_started_late_are_reduced() {
     each_ok_within_1pp(&run_logged_seeds(&[2138, 2181, 2404], bessel(0.10, 0.40), true));
+}
+
+/// Logged draws that were flagged for a ratio read to more than ± 5 pp while
+/// within 0.03 pp (forty-ninth session): a contact fit the log leaned towards
+/// read some peak faster than the instantaneous fit and was carried in u
+/// (stated causal 5036 and 5184, r₁ ± 5.0 and ± 6.5 pp; unstated FIR 4136,
+/// ± 8.7 pp). A leaning reading that speeds a peak up is not carried
+/// (`peaks::segments::LEANING_FASTER`): each is ok and within 1 pp.
+#[test]
+fn logged_tests_once_flagged_for_a_faster_contact_reading_are_reduced() {
+    each_ok_within_1pp(&run_logged_seeds(&[5036, 5184], all_causal(), true));
+    each_ok_within_1pp(&run_logged_seeds(&[4136], LoggerDraw::Fir, false));
 }
 
 /// Unstated-Bessel draws flagged while an equal fit of the contact phases

@@ -108,7 +108,12 @@ fn tests_once_missed_are_reduced() {
 /// arcs): each is now ok and within 1 pp.
 #[test]
 fn fresh_draws_once_missed_are_reduced() {
-    for idx in [101045, 101070, 101144, 101439, 1166] {
+    each_rigid_draw_ok_within_1pp(&[101045, 101070, 101144, 101439, 1166]);
+}
+
+/// Each idealised draw of `indices` (`synth::draw`) is ok and within 1 pp.
+fn each_rigid_draw_ok_within_1pp(indices: &[u64]) {
+    for &idx in indices {
         let s = score(&draw(idx, Family::Rigid));
         let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
         assert!(s.status == "ok" && w <= 1.0, "draw {idx}: {w} pp, {}", s.status);
@@ -124,11 +129,7 @@ fn fresh_draws_once_missed_are_reduced() {
 /// (`peaks::segments::LEANING_FASTER`): each is now ok and within 1 pp.
 #[test]
 fn fresh_draws_once_flagged_for_a_faster_contact_reading_are_reduced() {
-    for idx in [401006, 401235, 401341] {
-        let s = score(&draw(idx, Family::Rigid));
-        let w = s.worst_pp.clone().unwrap_or(f64::INFINITY);
-        assert!(s.status == "ok" && w <= 1.0, "draw {idx}: {w} pp, {}", s.status);
-    }
+    each_rigid_draw_ok_within_1pp(&[401006, 401235, 401341]);
 }
 
 /// 12 compliant draws: none silently wrong (the full draw gives the rate).

@@ -493,6 +493,20 @@ fn fresh_draws_through_a_second_order_filter_are_reduced() {
     each_ok_within_1pp(&run_logged_seeds(&[106008, 106132], all_causal(), false));
 }
 
+/// Unstated-causal draws of the fresh seeds `DRAW_SEED_OFFSET=300000` and
+/// `400000` (forty-eighth and forty-ninth sessions): 306194 and 406136, each
+/// two-sided at 100 Hz behind a Butterworth 2 (0.155 and 0.251 f_s), were ok
+/// but 2.83 and 2.05 pp off: a Butterworth 4 fitted each log to the noise, so
+/// the second order was not tried, and the contact phases, which fitted better
+/// than the Butterworth 4, read the filter's rounding (peaks 4–19 % low).
+/// The second order is now tried where every fourth-order response loses to
+/// the model without a filter (`acquisition::Generic::Butterworth2`): each is
+/// ok and within 1 pp.
+#[test]
+fn fresh_draws_whose_fourth_order_fit_lost_to_the_contacts_are_reduced() {
+    each_ok_within_1pp(&run_logged_seeds(&[306194, 406136], all_causal(), false));
+}
+
 /// Unstated-Bessel draw 203065 of the seeds `DRAW_SEED_OFFSET=200000`
 /// (forty-first session): a Bessel 2 at 0.395 f_s, 100 Hz, with a 1.3 mm
 /// spike one sample after impact 3. The spike filter found it, but its

@@ -1427,8 +1427,9 @@ fn a_contact_fit_minimum_the_log_leaves_open_widens_u() {
 /// kept their filters, and H2_70_1 was ok with r⁺ 4.92 ± 2.46 pp off (H2_110_1
 /// and H2_80_1 1.08 and 0.98 pp). Read again with contact phases and no filter,
 /// H2_110_1 and H2_80_1 pass their checks (measured 0.29 and 0.31 pp) and
-/// H2_70_1 fails them (its contact at impact 4 is not short beside its
-/// half-cycles), so it is suspect with both readings' reason. Asserted: no ok
+/// H2_70_1 fails them (with `filter = "none"` stated, its contact at impact 4
+/// is not short beside its half-cycles), so it is suspect with both readings'
+/// reason. Asserted: no ok
 /// test more than 1.0 pp off, H2_70_1 flagged, the other two ok with contact
 /// phases, no filter and the campaign's warning, ≥ 90 % of the ok peaks
 /// within 2 u.

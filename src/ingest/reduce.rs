@@ -298,13 +298,11 @@ enum Reread {
 
 /// Whether a test was read through an unstated low-pass estimated below
 /// [`crate::peaks::acquisition::WIDE_ROUNDING`] of its sampling rate: a
-/// rounding as wide as a compliant contact's.
+/// rounding as wide as a compliant contact's (the sampling interval the
+/// median step, as the estimator takes it, `peaks::prepare_log`).
 fn wide_estimate(r: &crate::reduction::Reduced) -> bool {
-    let t = &r.log.time_s;
-    let dt = match (t.first(), t.last()) {
-        (Some(a), Some(b)) if t.len() > 1 => (b - a) / (t.len() - 1) as f64,
-        _ => return false,
-    };
+    let steps: Vec<f64> = r.log.time_s.windows(2).map(|w| w[1] - w[0]).collect();
+    let dt = crate::signal::median(&steps);
     r.analysis.response.source == "estimated"
         && r.analysis
             .response

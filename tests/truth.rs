@@ -1451,31 +1451,6 @@ fn a_wide_estimated_rounding_beside_one_test_with_contacts_is_read_as_the_contac
     }
 }
 
-/// Residuals that stand out around one impact of a compliant two-sided wall,
-/// where the table's peaks are not read from the samples around it
-/// (fifty-first session, `peaks::left_out_vouches`):
-/// `mujoco-public-like-two-sided-s5309` (`tools/mujoco_campaign.py --preset
-/// public-like-two-sided --seed 5309`). Q2_150_1 (200 Hz) was suspect for
-/// its residuals around impact 4 alone (8.6 × the noise), every value within
-/// 0.18 pp; its peak 4 has no local reading (no resolved contact, no kink fit),
-/// so the local readings could not vouch, and with Q2_70_1 (a contact at
-/// impact 5 lasting 107 of its 134 ms half-cycle) the campaign had two tests
-/// flagged. Re-fitted without the samples within 3 samples of impact 4, no
-/// peak moves by more than 0.3 of its u: the test is ok with that note.
-/// Asserted: issue 18's criterion on the campaign (measured: Q2_70_1 flagged
-/// alone, the ok tests within 0.18 pp, every peak within 2 u), Q2_150_1 ok
-/// within 1.0 pp with the note, Q2_70_1 still flagged.
-#[test]
-fn residuals_around_an_impact_no_peak_is_read_from_are_no_reason() {
-    let name = "mujoco-public-like-two-sided-s5309";
-    let a = issue_18_with_ok_test(name, "Q2_150_1");
-    let note = a.model_note.unwrap_or_default();
-    assert!(note.contains("re-fitted without the samples around it"), "{note}");
-    let (_, rep) = engine_reduction(&fixture_dir(name), name);
-    let r = rep.iter().find(|r| r.0 == "Q2_70_1").expect("Q2_70_1");
-    assert!(!r.2, "Q2_70_1 ok, {:.2} pp off", r.1);
-}
-
 /// A two-sided fit that misses the log smoothly and for no other reason
 /// (`peaks::CarriedMisfit`, forty-fourth session): the 70 mm test of
 /// `mujoco-holdout-two-sided-s3504` (`--preset holdout-two-sided --seed

@@ -1165,15 +1165,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         };
         let past_the_table_checked = past_note.is_some();
         let model_note = model_note.or(past_note);
-        let left_out_note = std::cell::Cell::new(None);
-        let left_out = |onsets: &[f64]| {
-            let u: Vec<f64> = peaks.iter().map(|q| q.velocity_u_mm_s.unwrap_or(0.0)).collect();
-            let vouches = left_out_vouches(&fit, phys, onsets, (&impacts, &u), p.dt);
-            if vouches {
-                left_out_note.set(Some(left_out_note_text()));
-            }
-            vouches
-        };
         let verdict = quality::plausibility(
             &fit,
             &resid,
@@ -1183,9 +1174,8 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             &methods,
             (p.dt, p.sigma),
             exits_misfit || deferred_misfit.is_some() || past_the_table_checked,
-            (&late, &left_out),
+            &late,
         );
-        let model_note = model_note.or(left_out_note.take());
         let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
         let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks, opts.onset));
         // Where the uncertainties cannot be computed, none is stated (never u = 0):
@@ -1244,40 +1234,6 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         deferred_misfit,
         wide_rounding: fit.estimated.as_ref().and_then(|(e, _)| wide_rounding(e, p.dt)),
     })
-}
-
-/// Whether residuals that stand out around impacts of the table (their
-/// `onsets`) are no reason on this fit: a two-sided fit with contact phases
-/// and no logger filter, re-fitted without the samples within
-/// ±[`LEAVE_OUT_SAMPLES`] of those impacts, gives back every peak of the table
-/// within [`LEAVE_OUT_MOVE`] of its u (`u`, mm/s; [`no_peak_moves_without`]).
-/// Asked only where the local readings do not vouch for the peaks
-/// ([`vouch`]).
-///
-/// Why: on a compliant bedding the global fit's one contact shape per
-/// direction cannot follow each impact's, and the residuals around one impact
-/// then spread 8–13 × the noise on tests whose values are within 0.17–0.27 pp
-/// of the truth (five MuJoCo tests of the fifty-first session's 92 campaigns:
-/// two-sided, 200–1000 Hz), while one of their peaks has no local reading
-/// (the samples neither resolve a contact's smooth extreme nor fit a kink), so
-/// [`vouch`] cannot vouch. What the reason warns of, an impact that is not
-/// where the fit puts it, matters only where the table's peaks are read from
-/// the samples around it; the leave-out re-fit asks exactly that, as it does
-/// for a one-sided wall's exits ([`exits_only_misfit`]) and for impacts past
-/// the table ([`past_the_table`]). Not on one-sided walls, whose residuals
-/// that stand out have their own rules (`inward`, [`exits_only_misfit`]), nor
-/// through a filter, stated or estimated, whose rounding the model carries.
-fn left_out_vouches(fit: &SegmentFit, phys: &Physics, onsets: &[f64], (impacts, u): (&[Impact], &[f64]), dt: f64) -> bool {
-    phys.rocking == Rocking::TwoSided
-        && unfiltered_contacts(fit)
-        && !onsets.is_empty()
-        && onsets.iter().all(|t| t.is_finite())
-        && no_peak_moves_without(fit, onsets, impacts, u, dt)
-}
-
-/// The report's note where [`left_out_vouches`] withdrew the reason.
-fn left_out_note_text() -> String {
-    format!("the residuals stand out around an impact of the table (the global fit's contact there is not the wall's), but re-fitted without the samples around it no peak of the table moves by more than {LEAVE_OUT_MOVE} of its u: the peaks are not read from there")
 }
 
 /// [`checks::structured_near_impacts`] on the global fit, its onsets those of

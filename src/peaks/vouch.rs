@@ -56,17 +56,6 @@
 //! uncorrelated instead); elsewhere a one-sided test whose residuals stand out
 //! stays suspect.
 //!
-//! # Where no local reading exists: the leave-out re-fit
-//! A peak with neither a resolved contact nor a kink reading vouches for
-//! nothing here. On a two-sided fit with contact phases and no filter the
-//! caller then asks the leave-out re-fit (`super::left_out_vouches`): where
-//! the fit re-fitted without the samples around the impacts that stand out
-//! gives back every peak of the table within 0.3 of its u, the peaks are not
-//! read from there and the reason is withdrawn, with a note (fifty-first
-//! session, 60 two-sided MuJoCo campaigns: the five tests flagged for these
-//! residuals alone, 0.17–0.27 pp off, and one whose re-reading with contact
-//! phases had failed on them, 0.39 pp, became ok; docs/accuracy.md).
-//!
 //! No crate does this: it compares readings of this crate's own estimators.
 
 use super::late::LatePeak;

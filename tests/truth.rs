@@ -577,6 +577,10 @@ fn a_contact_is_not_read_as_an_estimated_filter() {
 /// campaign. Measured (seventeenth session): read through an estimated Bessel 4
 /// at 12.1 Hz, its contact reading fails its checks, and it is suspect for the
 /// unknown filter, naming both readings; the campaign's own four tests stay ok.
+/// Fifty-first session: the leave-out rule for residuals around an impact
+/// (`peaks::left_out_vouches`) let that contact reading pass; it is off on a
+/// reading that replaces one through an estimated filter
+/// (`PeakOptions::filter_ruled_out`).
 #[test]
 fn a_filter_and_failing_contacts_leave_the_test_suspect() {
     use rocklab::report::quality::{kind, split, Kind};
@@ -1449,6 +1453,31 @@ fn a_wide_estimated_rounding_beside_one_test_with_contacts_is_read_as_the_contac
         assert!(a.contact_phases && a.response.source != "estimated", "{id}: {:?}", a.response);
         assert!(t.warnings.iter().any(|w| w.contains("tests that can tell")), "{id}: {:?}", t.warnings);
     }
+}
+
+/// Residuals that stand out around one impact of a compliant two-sided wall,
+/// where the table's peaks are not read from the samples around it
+/// (fifty-first session, `peaks::left_out_vouches`):
+/// `mujoco-public-like-two-sided-s5309` (`tools/mujoco_campaign.py --preset
+/// public-like-two-sided --seed 5309`). Q2_150_1 (200 Hz) was suspect for
+/// its residuals around impact 4 alone (8.6 × the noise), every value within
+/// 0.18 pp; its peak 4 has no local reading (no resolved contact, no kink fit),
+/// so the local readings could not vouch, and with Q2_70_1 (a contact at
+/// impact 5 lasting 107 of its 134 ms half-cycle) the campaign had two tests
+/// flagged. Re-fitted without the samples within 3 samples of impact 4, no
+/// peak moves by more than 0.3 of its u: the test is ok with that note.
+/// Asserted: issue 18's criterion on the campaign (measured: Q2_70_1 flagged
+/// alone, the ok tests within 0.18 pp, every peak within 2 u), Q2_150_1 ok
+/// within 1.0 pp with the note, Q2_70_1 still flagged.
+#[test]
+fn residuals_around_an_impact_no_peak_is_read_from_are_no_reason() {
+    let name = "mujoco-public-like-two-sided-s5309";
+    let a = issue_18_with_ok_test(name, "Q2_150_1");
+    let note = a.model_note.unwrap_or_default();
+    assert!(note.contains("re-fitted without the samples around it"), "{note}");
+    let (_, rep) = engine_reduction(&fixture_dir(name), name);
+    let r = rep.iter().find(|r| r.0 == "Q2_70_1").expect("Q2_70_1");
+    assert!(!r.2, "Q2_70_1 ok, {:.2} pp off", r.1);
 }
 
 /// A two-sided fit that misses the log smoothly and for no other reason

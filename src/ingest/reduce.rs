@@ -367,6 +367,7 @@ fn contacts_of_the_wall(
         }
         let unfiltered = PeakOptions {
             acquisition: crate::peaks::acquisition::Acquisition::None,
+            filter_ruled_out: true,
             ..expected
         };
         let spec = crate::ingest::manifest::TestSpec {

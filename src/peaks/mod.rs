@@ -146,6 +146,13 @@ pub struct PeakOptions {
     /// Where the onset of contact lies for a peak read as an instantaneous
     /// impact ([`uncertainty::add_unresolved_contact`]).
     pub onset: Onset,
+    /// This reading replaces one through a low-pass estimated from the log's
+    /// rounded impacts, the rounding now read as the wall's contacts (the
+    /// wide-rounding rule, [`contacts_for_a_wide_rounding`], and the
+    /// campaign's, `ingest::reduce::contacts_of_the_wall`). A rule that
+    /// holds only where no filter rounds the impacts is then off
+    /// ([`left_out_vouches`]).
+    pub filter_ruled_out: bool,
 }
 
 /// What is known of the contact's onset at a peak read as an instantaneous
@@ -173,6 +180,7 @@ impl Default for PeakOptions {
             contacts: ContactModel::FromLog,
             acquisition: acquisition::Acquisition::Unknown,
             onset: Onset::WithinSample,
+            filter_ruled_out: false,
         }
     }
 }
@@ -504,6 +512,7 @@ fn contacts_for_a_wide_rounding(t: &[f64], x: &[f64], phys: &Physics, opts: &Pea
     let unfiltered = PeakOptions {
         acquisition: acquisition::Acquisition::None,
         contacts: ContactModel::Expected,
+        filter_ruled_out: true,
         ..*opts
     };
     let read = prepare_log(t, x, opts.n_peaks).and_then(|p| segments_analysis(t, p, phys, &unfiltered));
@@ -1165,6 +1174,15 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         };
         let past_the_table_checked = past_note.is_some();
         let model_note = model_note.or(past_note);
+        let left_out_note = std::cell::Cell::new(None);
+        let left_out = |onsets: &[f64]| {
+            let u: Vec<f64> = peaks.iter().map(|q| q.velocity_u_mm_s.unwrap_or(0.0)).collect();
+            let vouches = left_out_vouches(&fit, (phys, opts), onsets, (&impacts, &u), p.dt);
+            if vouches {
+                left_out_note.set(Some(left_out_note_text()));
+            }
+            vouches
+        };
         let verdict = quality::plausibility(
             &fit,
             &resid,
@@ -1174,8 +1192,9 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
             &methods,
             (p.dt, p.sigma),
             exits_misfit || deferred_misfit.is_some() || past_the_table_checked,
-            &late,
+            (&late, &left_out),
         );
+        let model_note = model_note.or(left_out_note.take());
         let verdict = acquisition::with_family_check(verdict, fit.estimated.as_ref().map(|e| &e.0), &peaks);
         let verdict = verdict.with(free_arc_ends_disagree(t, &p, phys, &fit, &peaks, n_peaks, opts.onset));
         // Where the uncertainties cannot be computed, none is stated (never u = 0):
@@ -1234,6 +1253,52 @@ fn by_segments(t: &[f64], p: Prepared, phys: &Physics, opts: &PeakOptions) -> Re
         deferred_misfit,
         wide_rounding: fit.estimated.as_ref().and_then(|(e, _)| wide_rounding(e, p.dt)),
     })
+}
+
+/// Whether residuals that stand out around impacts of the table (their
+/// `onsets`) are no reason on this fit: a two-sided fit with contact phases
+/// and no logger filter, re-fitted without the samples within
+/// ±[`LEAVE_OUT_SAMPLES`] of those impacts, gives back every peak of the table
+/// within [`LEAVE_OUT_MOVE`] of its u (`u`, mm/s; [`no_peak_moves_without`]).
+/// Asked only where the local readings do not vouch for the peaks
+/// ([`vouch`]).
+///
+/// Why: on a compliant bedding the global fit's one contact shape per
+/// direction cannot follow each impact's, and the residuals around one impact
+/// then spread 8–13 × the noise on tests whose values are within 0.17–0.27 pp
+/// of the truth (five MuJoCo tests of the fifty-first session's 92 campaigns:
+/// two-sided, 200–1000 Hz), while one of their peaks has no local reading
+/// (the samples neither resolve a contact's smooth extreme nor fit a kink), so
+/// [`vouch`] cannot vouch. What the reason warns of, an impact that is not
+/// where the fit puts it, matters only where the table's peaks are read from
+/// the samples around it; the leave-out re-fit asks exactly that, as it does
+/// for a one-sided wall's exits ([`exits_only_misfit`]) and for impacts past
+/// the table ([`past_the_table`]). Not on one-sided walls, whose residuals
+/// that stand out have their own rules (`inward`, [`exits_only_misfit`]), nor
+/// through a filter, stated or estimated, whose rounding the model carries,
+/// nor where this reading replaces one through an estimated filter
+/// ([`PeakOptions::filter_ruled_out`]): the samples left out are those a
+/// low-pass rounds, so a filtered log re-fitted without them gives its peaks
+/// back whatever the filter did to them. Fifty-second session: without this
+/// gate, Q2_110_1 of the 100 Hz MuJoCo stand-in behind an unstated Bessel 4
+/// at 0.35 f_s (`tests/truth.rs`,
+/// `a_filter_and_failing_contacts_leave_the_test_suspect`), re-read with
+/// contact phases and no filter by its campaign, passed on this rule alone,
+/// so the filter it was seen through was dropped unvouched; with it, of the
+/// 60 two-sided MuJoCo campaigns only h2-s5208 H2_70_1 (ok at 0.39 pp on its
+/// campaign's re-reading without the gate) stays suspect.
+fn left_out_vouches(fit: &SegmentFit, (phys, opts): (&Physics, &PeakOptions), onsets: &[f64], (impacts, u): (&[Impact], &[f64]), dt: f64) -> bool {
+    phys.rocking == Rocking::TwoSided
+        && !opts.filter_ruled_out
+        && unfiltered_contacts(fit)
+        && !onsets.is_empty()
+        && onsets.iter().all(|t| t.is_finite())
+        && no_peak_moves_without(fit, onsets, impacts, u, dt)
+}
+
+/// The report's note where [`left_out_vouches`] withdrew the reason.
+fn left_out_note_text() -> String {
+    format!("the residuals stand out around an impact of the table (the global fit's contact there is not the wall's), but re-fitted without the samples around it no peak of the table moves by more than {LEAVE_OUT_MOVE} of its u: the peaks are not read from there")
 }
 
 /// [`checks::structured_near_impacts`] on the global fit, its onsets those of

@@ -28,6 +28,11 @@ pub(super) fn local_peaks(fit: &SegmentFit, n: usize, sigma: f64) -> Vec<Option<
         .collect()
 }
 
+/// The two ways the peaks may be vouched for despite residuals that stand out
+/// around an impact: the local readings (computed only then) and the
+/// caller's leave-out re-fit, given the onsets to leave out.
+pub(super) type Vouchers<'a> = (&'a dyn Fn() -> Vec<LatePeak>, &'a dyn Fn(&[f64]) -> bool);
+
 /// Run every check of [`checks`] on a fit (`spread[k]`: the difference between
 /// peak k's two readings of where its half-cycle ends,
 /// [`super::model::Model::peak_spread`]).
@@ -55,7 +60,7 @@ pub(super) fn plausibility(
     methods: &[ReadingMethod],
     (dt, sigma): (f64, f64),
     structured_elsewhere: bool,
-    late: &dyn Fn() -> Vec<LatePeak>,
+    (late, left_out): Vouchers,
 ) -> Quality {
     let is_local = |k: usize| methods.get(k) == Some(&ReadingMethod::LocalExtreme);
     let local: Vec<Option<(f64, f64)>> = local.iter().enumerate().map(|(k, l)| if is_local(k) { None } else { *l }).collect();
@@ -82,7 +87,7 @@ pub(super) fn plausibility(
         if structured_elsewhere {
             None
         } else {
-            structured_unvouched(fit, resid, &onsets, peaks, dt, sigma, late)
+            structured_unvouched(fit, resid, &onsets, peaks, (dt, sigma), (late, left_out))
         },
         checks::disagreement(&v_onset, &u, &local),
         m.contact_windows().and_then(|windows| {
@@ -126,16 +131,22 @@ pub(super) fn checked_onsets(m: &super::model::Model, methods: &[ReadingMethod])
 }
 
 /// [`checks::structured_near_impacts`], unless the local readings vouch for the
-/// peaks ([`vouch`]).
+/// peaks ([`vouch`]) or the peaks do not depend on the samples around the
+/// impacts that stand out (`left_out`, given their onsets: the caller's
+/// leave-out re-fit, `super::left_out_vouches`).
 fn structured_unvouched(
     fit: &SegmentFit,
     resid: &[f64],
     onsets: &[f64],
     peaks: &[Peak],
-    dt: f64,
-    sigma: f64,
-    late: &dyn Fn() -> Vec<LatePeak>,
+    (dt, sigma): (f64, f64),
+    (late, left_out): Vouchers,
 ) -> Option<String> {
-    let reason = checks::structured_near_impacts(&fit.tw, resid, onsets, dt, sigma)?;
-    (!vouch::vouched(peaks, &late())).then_some(reason)
+    let standing = checks::structured_impacts(&fit.tw, resid, onsets, dt, sigma);
+    let &(first, spread) = standing.first()?;
+    if vouch::vouched(peaks, &late()) {
+        return None;
+    }
+    let at: Vec<f64> = standing.iter().map(|&(k, _)| onsets[k]).collect();
+    (!left_out(&at)).then(|| checks::standing_out(first, spread, sigma))
 }

@@ -126,7 +126,13 @@
 //! (RMS against the truth 0.0231–0.0420 → 0.0191–0.0406; within issue 20's 0.025:
 //! 9 → 15): on those walls the readings' rise rests on the first impacts, so the
 //! rule that outlives the release keeps their constants (the public campaign's
-//! outlives it).
+//! outlives it). The engine asked directly (fifty-fifth session,
+//! `tools/mujoco_release_probe.py`, docs/restitution-law.md): released from smaller
+//! displacements, a release's impact reads 0.020–0.022 below a later impact at the
+//! same amplitude on both walls, and the second inward impact 0.013–0.017 below the
+//! third; the engine's truth without each test's first impact is flat on the eight
+//! campaigns whose readings favoured the rise. The rise those campaigns' readings
+//! carry is in part a transient of the first impacts, not a law of amplitude.
 //!
 //! The incomplete beta function (for the F distribution) is Numerical Recipes §6.4
 //! (continued fraction by the modified Lentz method; ln Γ by Lanczos, §6.1): a dozen

@@ -1,0 +1,73 @@
+#!/usr/bin/env python3
+"""Does a one-sided wall's inward r depend on the amplitude alone, or on the impact's place in the test?
+
+Not run by CI: a probe of the engine behind `tools/mujoco_campaign.py` (issue 20, the
+inward side of a one-sided wall, docs/restitution-law.md). It releases one wall, with
+one fixed draw of its bedding and transverse walls, from several displacements, and
+prints the engine's own r_k = |v_{k+1}/v_k| / e_H of the inward impacts (k = 0, 2, 4, 6)
+with the amplitude a_k = apex |theta| / alpha of the half-cycle each ends: the truth's
+peaks and crossings exactly as the campaigns' truth.json (`campaign_common.truth_peaks`).
+A release from a smaller displacement puts its first impact (the release's, k = 0) at
+the amplitude of a later impact of a larger release, so the two can be compared at the
+same amplitude, which a campaign's tests, all released from 130-170 mm, never allow.
+
+    pip install mujoco numpy
+    python3 tools/mujoco_release_probe.py --preset public-like-one-sided \
+        --draw 0.0031,0.9,1800,0.07 --releases 170,140,110,80,60,45
+
+`--draw` is what `build` would draw, in its order: the bedding's time constant (s),
+the friction coefficient, the transverse walls' stiffness K (s^-2) and damping ratio.
+"""
+import argparse
+import math
+
+import mujoco_campaign as mc
+from campaign_common import truth_peaks
+
+
+class Fixed:
+    """The draws of `build`, handed out in its order."""
+
+    def __init__(self, values):
+        self.values = list(values)
+
+    def uniform(self, a, b):
+        return self.values.pop(0)
+
+
+def inward_r(p, draw, x0_mm):
+    """(k, a_k, r_k) of the inward impacts k = 0, 2, 4, 6 of a release from x0_mm."""
+    traj, _, t_rel, _ = mc.simulate(p, x0_mm, Fixed(draw))
+    peaks, _ = truth_peaks(traj, t_rel)
+    alpha = math.atan(p["b"] / p["H"])
+    e_h = 1 - 1.5 * math.sin(alpha) ** 2
+    t, th = traj[:, 0], traj[:, 3]
+    rows = []
+    start = int(t.searchsorted(t_rel))
+    for k in range(0, min(len(peaks) - 1, 8), 2):
+        # The half-cycle impact k ends runs from the previous peak's crossing to its own;
+        # its apex lies between the previous peak and this one (the release for k = 0).
+        lo = start if k == 0 else peaks[k - 1]["i"]
+        apex = max(abs(x) for x in th[lo : peaks[k]["i"] + 1]) / alpha
+        r = abs(peaks[k + 1]["velocity_mm_s"] / peaks[k]["velocity_mm_s"]) / e_h
+        rows.append((k, apex, r))
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--preset", required=True, choices=sorted(mc.PRESETS))
+    ap.add_argument("--draw", required=True, help="bedding time constant, friction, K, damping ratio")
+    ap.add_argument("--releases", required=True, help="release displacements in mm, comma-separated")
+    args = ap.parse_args()
+    p = mc.PRESETS[args.preset]
+    if p["rocking"] != "one-sided":
+        ap.error("the probe asks about the inward side of a one-sided wall")
+    draw = [float(v) for v in args.draw.split(",")]
+    for x0 in [float(v) for v in args.releases.split(",")]:
+        rows = inward_r(p, draw, x0)
+        print(f"x0 {x0:5.0f} mm  " + "  ".join(f"k{k} a {a:.3f} r {r:.4f}" for k, a, r in rows), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -4,8 +4,8 @@
 Not run by CI: a probe of the engine behind `tools/mujoco_campaign.py` (issue 20, the
 inward side of a one-sided wall, docs/restitution-law.md). It releases one wall, with
 one fixed draw of its bedding and transverse walls, from several displacements, and
-prints the engine's own r_k = |v_{k+1}/v_k| / e_H of the inward impacts (k = 0, 2, 4, 6)
-with the amplitude a_k = apex |theta| / alpha of the half-cycle each ends: the truth's
+prints the engine's own r_k = |v_{k+1}/v_k| / e_H of the inward impacts (k = 0, 2, 4, 6;
+`--outward`: k = 1, 3, 5, 7, the ends of the pushes) with the amplitude a_k = apex |theta| / alpha of the half-cycle each ends: the truth's
 peaks and crossings exactly as the campaigns' truth.json (`campaign_common.truth_peaks`).
 A release from a smaller displacement puts its first impact (the release's, k = 0) at
 the amplitude of a later impact of a larger release, so the two can be compared at the
@@ -35,8 +35,9 @@ class Fixed:
         return self.values.pop(0)
 
 
-def inward_r(p, draw, x0_mm):
-    """(k, a_k, r_k) of the inward impacts k = 0, 2, 4, 6 of a release from x0_mm."""
+def impacts_r(p, draw, x0_mm, side):
+    """(k, a_k, r_k) of the inward impacts k = 0, 2, 4, 6 (side 0) or the outward ones
+    k = 1, 3, 5, 7 (side 1) of a release from x0_mm."""
     traj, _, t_rel, _ = mc.simulate(p, x0_mm, Fixed(draw))
     peaks, _ = truth_peaks(traj, t_rel)
     alpha = math.atan(p["b"] / p["H"])
@@ -44,7 +45,7 @@ def inward_r(p, draw, x0_mm):
     t, th = traj[:, 0], traj[:, 3]
     rows = []
     start = int(t.searchsorted(t_rel))
-    for k in range(0, min(len(peaks) - 1, 8), 2):
+    for k in range(side, min(len(peaks) - 1, 8 + side), 2):
         # The half-cycle impact k ends runs from the previous peak's crossing to its own;
         # its apex lies between the previous peak and this one (the release for k = 0).
         lo = start if k == 0 else peaks[k - 1]["i"]
@@ -59,13 +60,14 @@ def main():
     ap.add_argument("--preset", required=True, choices=sorted(mc.PRESETS))
     ap.add_argument("--draw", required=True, help="bedding time constant, friction, K, damping ratio")
     ap.add_argument("--releases", required=True, help="release displacements in mm, comma-separated")
+    ap.add_argument("--outward", action="store_true", help="the outward impacts (k odd, the pushes' ends) instead")
     args = ap.parse_args()
     p = mc.PRESETS[args.preset]
     if p["rocking"] != "one-sided":
         ap.error("the probe asks about the inward side of a one-sided wall")
     draw = [float(v) for v in args.draw.split(",")]
     for x0 in [float(v) for v in args.releases.split(",")]:
-        rows = inward_r(p, draw, x0)
+        rows = impacts_r(p, draw, x0, 1 if args.outward else 0)
         print(f"x0 {x0:5.0f} mm  " + "  ".join(f"k{k} a {a:.3f} r {r:.4f}" for k, a, r in rows), flush=True)
 
 

@@ -5,8 +5,9 @@ Not run by CI: a probe of the engine behind `tools/mujoco_campaign.py` (issue 20
 inward side of a one-sided wall, docs/restitution-law.md). It releases one wall, with
 one fixed draw of its bedding and transverse walls, from several displacements, and
 prints the engine's own r_k = |v_{k+1}/v_k| / e_H of the inward impacts (k = 0, 2, 4, 6;
-`--outward`: k = 1, 3, 5, 7, the ends of the pushes) with the amplitude a_k = apex |theta| / alpha of the half-cycle each ends: the truth's
-peaks and crossings exactly as the campaigns' truth.json (`campaign_common.truth_peaks`).
+`--outward`: k = 1, 3, 5, 7, the ends of the pushes) with the amplitude
+a_k = apex |theta| / alpha of the half-cycle each ends: the truth's peaks and crossings
+exactly as the campaigns' truth.json (`campaign_common.truth_peaks`).
 A release from a smaller displacement puts its first impact (the release's, k = 0) at
 the amplitude of a later impact of a larger release, so the two can be compared at the
 same amplitude, which a campaign's tests, all released from 130-170 mm, never allow.
@@ -25,20 +26,16 @@ import mujoco_campaign as mc
 from campaign_common import truth_peaks
 
 
-class Fixed:
-    """The draws of `build`, handed out in its order."""
-
-    def __init__(self, values):
-        self.values = list(values)
-
-    def uniform(self, a, b):
-        return self.values.pop(0)
+def fixed(draw):
+    """The draws of `build` as a stored `sim` block replays them (`mujoco_campaign.Replay`)."""
+    tc, mu, k, zeta = draw
+    return mc.Replay(dict(floor_solref=[tc, 1.0], friction_mu=mu, obst_K_target_per_s2=k, obst_zeta=zeta))
 
 
 def impacts_r(p, draw, x0_mm, side):
     """(k, a_k, r_k) of the inward impacts k = 0, 2, 4, 6 (side 0) or the outward ones
     k = 1, 3, 5, 7 (side 1) of a release from x0_mm."""
-    traj, _, t_rel, _ = mc.simulate(p, x0_mm, Fixed(draw))
+    traj, _, t_rel, _ = mc.simulate(p, x0_mm, fixed(draw))
     peaks, _ = truth_peaks(traj, t_rel)
     alpha = math.atan(p["b"] / p["H"])
     e_h = 1 - 1.5 * math.sin(alpha) ** 2
@@ -46,8 +43,8 @@ def impacts_r(p, draw, x0_mm, side):
     rows = []
     start = int(t.searchsorted(t_rel))
     for k in range(side, min(len(peaks) - 1, 8 + side), 2):
-        # The half-cycle impact k ends runs from the previous peak's crossing to its own;
-        # its apex lies between the previous peak and this one (the release for k = 0).
+        # Impact k ends half-cycle k; its apex lies between peak k - 1 (just before
+        # crossing k - 1) and peak k (the release for k = 0).
         lo = start if k == 0 else peaks[k - 1]["i"]
         apex = max(abs(x) for x in th[lo : peaks[k]["i"] + 1]) / alpha
         r = abs(peaks[k + 1]["velocity_mm_s"] / peaks[k]["velocity_mm_s"]) / e_h
@@ -64,7 +61,7 @@ def main():
     args = ap.parse_args()
     p = mc.PRESETS[args.preset]
     if p["rocking"] != "one-sided":
-        ap.error("the probe asks about the inward side of a one-sided wall")
+        ap.error("the probe asks about a one-sided wall (its inward or, with --outward, its outward impacts)")
     draw = [float(v) for v in args.draw.split(",")]
     for x0 in [float(v) for v in args.releases.split(",")]:
         rows = impacts_r(p, draw, x0, 1 if args.outward else 0)

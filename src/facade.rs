@@ -14,7 +14,7 @@ use crate::ensemble::{self, CoefficientDist, Dist, Inputs, Nominal, Outcome, Pol
 use crate::fragility::{fit_lognormal, Fragility, FragilityError, Trial};
 use crate::ground_motion::Record;
 use crate::restitution_law::RestitutionLaw;
-use crate::solver::run::SolverError;
+use crate::solver::run::{Event, SolverError};
 use crate::solver::BlockSpec;
 use crate::study::{run, RunSpec, RunSummary};
 use crate::wall::{housner_e, Rocking, Side};
@@ -215,6 +215,9 @@ pub struct StudyRun {
     pub well_conditioned: bool,
     /// max θ/α at the looser and the tighter tolerance.
     pub sensitivity: [f64; 2],
+    /// A law set's run: where its impacts fell against the law's data.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law_reach: Option<LawReach>,
     #[serde(skip)]
     pub history: Vec<crate::solver::run::Sample>,
 }
@@ -228,7 +231,9 @@ pub fn run_study(study: &Study, scale: f64, with_history: bool, tick: &(dyn Fn()
         .map(|&(r, s, p)| {
             let rec = &study.records[r];
             let set = &study.sets[s];
-            let (sum, sim) = run(&study.block, &rec.record, &study.spec(set, p, scale, study.rtol, with_history))?;
+            let spec = study.spec(set, p, scale, study.rtol, with_history);
+            let (sum, sim) = run(&study.block, &rec.record, &spec)?;
+            let law_reach = spec.law.map(|(law, e_h)| law_reach(&sim.events, &law, e_h));
             let loose = run(&study.block, &rec.record, &study.spec(set, p, scale, study.rtol * 100.0, false))?.0;
             let tight = run(&study.block, &rec.record, &study.spec(set, p, scale, study.rtol / 100.0, false))?.0;
             let close = |o: &RunSummary| {
@@ -243,11 +248,120 @@ pub fn run_study(study: &Study, scale: f64, with_history: bool, tick: &(dyn Fn()
                 scale,
                 well_conditioned: close(&loose) && close(&tight),
                 sensitivity: [loose.max_theta_over_alpha, tight.max_theta_over_alpha],
+                law_reach,
                 summary: sum,
                 history: sim.history,
             })
         })
         .collect()
+}
+
+/// The impacts of one side in a run, against a law's data (see [`LawReach`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct SideReach {
+    /// Impacts entering the side.
+    pub impacts: usize,
+    /// Of them, those that ended a half-cycle smaller than any the campaign
+    /// observed on the side (a below [`RestitutionLaw::observed`]'s smallest):
+    /// the law's form (extrapolated, or held), not its data, gave their r.
+    pub below_observed: usize,
+    /// Of them, those that ended a half-cycle larger than any the campaign
+    /// observed on the side.
+    pub above_observed: usize,
+    /// Of them, those whose e = min(1, r(a) e_H) is the cap 1 (an elastic impact).
+    pub elastic: usize,
+    /// Σ θ'² before the impacts ((rad/s)²: proportional to the kinetic energy
+    /// they met), over all of them and over those below and above the data.
+    pub energy: f64,
+    pub energy_below: f64,
+    pub energy_above: f64,
+    /// Σ θ'² e over the impacts: with `energy`, the coefficient the side's
+    /// impacts applied, weighted by the energy they met.
+    pub energy_e: f64,
+    /// The smallest and largest a = |θ|/α at which one of them read the law
+    /// (0 and 0 without impacts).
+    pub smallest_amplitude: f64,
+    pub largest_amplitude: f64,
+}
+
+/// Where a law set's impacts fell in a run: per side, how many read the law
+/// below or above the amplitudes the campaign observed there, and how many at
+/// the cap e = 1. A verdict that rests on such impacts rests on the law's
+/// extrapolation; the façade report says how many there were
+/// (docs/facade.md, "Where the laws reach beyond their data").
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct LawReach {
+    pub inward: SideReach,
+    pub outward: SideReach,
+}
+
+impl SideReach {
+    /// The energy-weighted mean e of the side's impacts (None without impacts).
+    pub fn mean_e(&self) -> Option<f64> {
+        (self.energy > 0.0).then(|| self.energy_e / self.energy)
+    }
+}
+
+impl LawReach {
+    /// Add another run's counts (the amplitudes' range is the union).
+    pub fn add(&mut self, other: &LawReach) {
+        for (a, b) in [(&mut self.inward, &other.inward), (&mut self.outward, &other.outward)] {
+            if b.impacts == 0 {
+                continue;
+            }
+            a.smallest_amplitude = if a.impacts == 0 {
+                b.smallest_amplitude
+            } else {
+                a.smallest_amplitude.min(b.smallest_amplitude)
+            };
+            a.largest_amplitude = a.largest_amplitude.max(b.largest_amplitude);
+            a.impacts += b.impacts;
+            a.below_observed += b.below_observed;
+            a.above_observed += b.above_observed;
+            a.elastic += b.elastic;
+            a.energy += b.energy;
+            a.energy_below += b.energy_below;
+            a.energy_above += b.energy_above;
+            a.energy_e += b.energy_e;
+        }
+    }
+}
+
+/// Count a run's impacts ([`Event::Impact`], each with the amplitude a its
+/// coefficient was read at) against `law` applied with `e_h`.
+pub fn law_reach(events: &[Event], law: &RestitutionLaw, e_h: f64) -> LawReach {
+    let mut reach = LawReach::default();
+    for ev in events {
+        if let Event::Impact {
+            entering,
+            amplitude_over_alpha: a,
+            v_before,
+            ..
+        } = *ev
+        {
+            let side = match entering {
+                Side::Inward => &mut reach.inward,
+                Side::Outward => &mut reach.outward,
+            };
+            let (lo, hi) = law.observed(entering);
+            side.smallest_amplitude = if side.impacts == 0 { a } else { side.smallest_amplitude.min(a) };
+            side.largest_amplitude = side.largest_amplitude.max(a);
+            side.impacts += 1;
+            let k = v_before * v_before;
+            side.energy += k;
+            side.energy_e += k * law.e(entering, a, e_h);
+            if a < lo {
+                side.below_observed += 1;
+                side.energy_below += k;
+            }
+            if a > hi {
+                side.above_observed += 1;
+                side.energy_above += k;
+            }
+            side.elastic += usize::from(law.e(entering, a, e_h) >= 1.0);
+        }
+    }
+    reach
 }
 
 /// A `--scales` text that is not FROM:TO:N.
@@ -578,6 +692,55 @@ pub fn fragility_by_set(study: &Study, runs: &[SampleRun]) -> Vec<SetFragility> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The counts of [`law_reach`] on made-up impacts against a law observed on
+    /// a = 0.01–0.2 inward and 0.005–0.03 outward: below, inside and above each
+    /// range, one capped at e = 1, with their energies and mean e.
+    #[test]
+    fn law_reach_counts_impacts_beyond_the_data() {
+        use crate::restitution_law::{LawForm, ObservedAmplitudes};
+        let mut law = RestitutionLaw::constant(0.6, 0.01, 0.8, 0.01);
+        law.form = LawForm::SpeedLoss;
+        law.parameters.inward.c = 0.01; // r = 0.6 − 0.01/√(a(2 − a)): 0.556 at a = 0.03
+        law.parameters.outward.r_inf = 1.1; // e = 1 at every a with e_H = 0.95
+        law.parameters.observed = Some(ObservedAmplitudes {
+            inward: [0.01, 0.2],
+            outward: [0.005, 0.03],
+        });
+        law.validate().unwrap();
+        let imp = |entering, v_before: f64, a| Event::Impact {
+            t: 0.0,
+            entering,
+            v_before,
+            v_after: 0.0,
+            amplitude_over_alpha: a,
+        };
+        let events = [
+            imp(Side::Inward, 1.0, 0.001),
+            imp(Side::Inward, 2.0, 0.03),
+            imp(Side::Inward, 3.0, 0.5),
+            Event::Rest { t: 1.0 },
+            imp(Side::Outward, 1.0, 0.01),
+            imp(Side::Outward, 1.0, 0.002),
+        ];
+        let r = law_reach(&events, &law, 0.95);
+        let (i, o) = (r.inward, r.outward);
+        assert_eq!((i.impacts, i.below_observed, i.above_observed, i.elastic), (3, 1, 1, 0));
+        assert_eq!((i.energy, i.energy_below, i.energy_above), (14.0, 1.0, 9.0));
+        assert_eq!((i.smallest_amplitude, i.largest_amplitude), (0.001, 0.5));
+        let e = |a| law.e(Side::Inward, a, 0.95);
+        let mean = (e(0.001) + 4.0 * e(0.03) + 9.0 * e(0.5)) / 14.0;
+        assert!((i.mean_e().unwrap() - mean).abs() < 1e-15);
+        assert_eq!((o.impacts, o.below_observed, o.above_observed, o.elastic), (2, 1, 0, 2));
+        assert_eq!(o.mean_e(), Some(1.0));
+        // Adding runs adds the counts and widens the range.
+        let mut sum = LawReach::default();
+        sum.add(&r);
+        sum.add(&law_reach(&events[4..5], &law, 0.95));
+        assert_eq!((sum.outward.impacts, sum.outward.below_observed, sum.inward.impacts), (3, 1, 3));
+        assert_eq!((sum.outward.smallest_amplitude, sum.outward.largest_amplitude), (0.002, 0.01));
+        assert_eq!(LawReach::default().inward.mean_e(), None);
+    }
 
     #[test]
     fn scales() {

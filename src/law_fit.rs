@@ -141,7 +141,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::impacts::ImpactTable;
-use crate::restitution_law::{EnergyLoss, LawForm, LawParameters, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
+use crate::restitution_law::{EnergyLoss, LawForm, LawParameters, ObservedAmplitudes, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
 use crate::wall::{Rocking, Side};
 
 /// Level of the test against a constant (before the Bonferroni split over sides).
@@ -523,6 +523,18 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
     // Where the inward r rises (c < 0) it is held below the inward side's own
     // smallest amplitude, not the campaign's (one-sided: the outward pushes').
     let inward_a_min = fitted[0].1 .2 .0.clamp(AMPLITUDE_FLOOR, 1.0);
+    // Each side's own amplitudes (one-sided: the inward free arcs' and the
+    // outward pushes'; two-sided: the shared group's on both), beyond which the
+    // façade study counts a run's impacts as beyond the law's data.
+    let range = |i: usize| {
+        let (lo, hi) = fitted[i].1 .2;
+        let lo = lo.clamp(AMPLITUDE_FLOOR, 1.0);
+        [lo, hi.clamp(lo, 1.0)]
+    };
+    let observed = ObservedAmplitudes {
+        inward: range(0),
+        outward: range(last),
+    };
     let parameters = |inward: SideLaw, outward: SideLaw| LawParameters {
         inward,
         outward,
@@ -530,6 +542,7 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
         amplitude_min: a_min.clamp(AMPLITUDE_FLOOR, 1.0),
         amplitude_max: a_max.clamp(a_min.clamp(AMPLITUDE_FLOOR, 1.0), 1.0),
         inward_amplitude_min: (rocking == Rocking::OneSided && inward.c < 0.0).then_some(inward_a_min),
+        observed: Some(observed),
     };
     let speed_loss = RestitutionLaw {
         form: LawForm::SpeedLoss,
@@ -871,6 +884,10 @@ mod tests {
         // smallest amplitude (the outward side's 0.002).
         assert_eq!(fit.law.parameters.inward_amplitude_min, Some(0.02));
         assert!((fit.law.parameters.amplitude_min - 0.002).abs() < 1e-12);
+        // Each side's own amplitudes, as the façade study reads them.
+        let (i, o) = (fit.law.observed(Side::Inward), fit.law.observed(Side::Outward));
+        assert!((i.0 - 0.02).abs() < 1e-12 && (i.1 - 0.4).abs() < 1e-12, "{i:?}");
+        assert!((o.0 - 0.002).abs() < 1e-12 && (o.1 - 0.04).abs() < 1e-12, "{o:?}");
         assert!((fit.law.r(Side::Inward, 0.005) - fit.law.r(Side::Inward, 0.02)).abs() < 1e-12);
         assert!((fit.law.r(Side::Inward, 0.02) - (0.62 + 0.03 * speed_shape(0.02))).abs() < 1e-9);
         assert!(fit.law.r(Side::Inward, 0.02) > fit.law.r(Side::Inward, 0.3));

@@ -185,6 +185,7 @@ impl LawPacking {
                 amplitude_min: AMPLITUDE_FLOOR,
                 amplitude_max: 1.0,
                 inward_amplitude_min: None,
+                observed: None,
             },
         })
     }
@@ -475,6 +476,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
             amplitude_min: span.0.max(AMPLITUDE_FLOOR),
             amplitude_max: span.1.clamp(span.0.max(AMPLITUDE_FLOOR), 1.0),
             inward_amplitude_min: None,
+            observed: None,
         },
     }
 }

@@ -376,6 +376,26 @@ pub struct LawParameters {
     /// outward side's pushes, which set `amplitude_min`). Absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inward_amplitude_min: Option<f64>,
+    /// The amplitudes of each side's own impacts, [smallest, largest] (one-sided
+    /// walls: the inward side's free arcs span far more than the outward side's
+    /// pushes; two-sided: the shared law's range on both). Beyond them the law
+    /// is extrapolated or held (# Range). Absent in laws written before it
+    /// (then [`RestitutionLaw::observed`] falls back on the campaign's range).
+    /// Read by the façade study to say how many of a run's impacts read the law
+    /// beyond its data.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed: Option<ObservedAmplitudes>,
+}
+
+/// The amplitudes a = |θ|/α of each side's impacts that a law was fitted on
+/// (`restitution_law.parameters.observed` in summary.json: `{"in": [lo, hi],
+/// "out": [lo, hi]}`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ObservedAmplitudes {
+    #[serde(rename = "in")]
+    pub inward: [f64; 2],
+    #[serde(rename = "out")]
+    pub outward: [f64; 2],
 }
 
 /// As read from JSON, before [`RestitutionLaw::validate`].
@@ -443,6 +463,7 @@ impl RestitutionLaw {
                 amplitude_min: AMPLITUDE_FLOOR,
                 amplitude_max: 1.0,
                 inward_amplitude_min: None,
+                observed: None,
             },
         }
     }
@@ -493,6 +514,31 @@ impl RestitutionLaw {
     pub fn r_u(&self, side: Side, amplitude_over_alpha: f64) -> f64 {
         let l = self.side(side);
         l.u(self.g(side, amplitude_over_alpha))
+    }
+
+    /// The amplitudes a = |θ|/α of `side`'s own impacts the law was fitted on,
+    /// (smallest, largest): `observed` where it is given, else the campaign's
+    /// `amplitude_min`–`amplitude_max` (the inward side from
+    /// `inward_amplitude_min` where that is given). Beyond them the law's r
+    /// comes from its form (extrapolated, or held: # Range), not from an impact
+    /// the campaign measured.
+    pub fn observed(&self, side: Side) -> (f64, f64) {
+        let p = &self.parameters;
+        match (p.observed, side) {
+            (Some(o), Side::Inward) => (o.inward[0], o.inward[1]),
+            (Some(o), Side::Outward) => (o.outward[0], o.outward[1]),
+            (None, Side::Inward) => (p.inward_amplitude_min.unwrap_or(p.amplitude_min), p.amplitude_max),
+            (None, Side::Outward) => (p.amplitude_min, p.amplitude_max),
+        }
+    }
+
+    /// [`Self::observed`] of both sides, as serialised.
+    pub fn observed_amplitudes(&self) -> ObservedAmplitudes {
+        let ((a, b), (c, d)) = (self.observed(Side::Inward), self.observed(Side::Outward));
+        ObservedAmplitudes {
+            inward: [a, b],
+            outward: [c, d],
+        }
     }
 
     /// The coefficient the solver applies: e = min(1, r(a) e_H).
@@ -598,6 +644,15 @@ impl RestitutionLaw {
                 return Err(format!("restitution law: inward_amplitude_min = {a} must lie in [{AMPLITUDE_FLOOR}, 1]"));
             }
         }
+        if let Some(o) = p.observed {
+            for (name, [lo, hi]) in [("in", o.inward), ("out", o.outward)] {
+                if !(lo.is_finite() && hi.is_finite() && AMPLITUDE_FLOOR <= lo && lo <= hi && hi <= 1.0) {
+                    return Err(format!(
+                        "restitution law: observed amplitudes of side \"{name}\" [{lo}, {hi}] must satisfy {AMPLITUDE_FLOOR} ≤ lo ≤ hi ≤ 1"
+                    ));
+                }
+            }
+        }
         if self.form == LawForm::Constant && (p.inward.c != 0.0 || p.outward.c != 0.0) {
             return Err("restitution law: form \"constant\" needs c = 0 on both sides".into());
         }
@@ -637,6 +692,7 @@ mod tests {
                 amplitude_min: 0.0024,
                 amplitude_max: 0.391,
                 inward_amplitude_min: None,
+                observed: None,
             },
         };
         let l = law(LawForm::SpeedLoss, side(0.6714, 0.0), side(1.1614, 0.0415));
@@ -673,6 +729,7 @@ mod tests {
                 amplitude_min: 0.01,
                 amplitude_max: 0.4,
                 inward_amplitude_min: None,
+                observed: None,
             },
         }
     }
@@ -817,6 +874,25 @@ mod tests {
             .contains("amplitude"));
         let bad = s.replace("speed-loss", "constant");
         assert!(serde_json::from_str::<RestitutionLaw>(&bad).unwrap_err().to_string().contains("c = 0"));
+        // Each side's observed amplitudes: absent (a law written before them),
+        // the campaign's range on both sides; given, read back; out of order or
+        // outside (0, 1], refused with the side named.
+        assert!(!s.contains("observed"), "{s}");
+        let range = (l.parameters.amplitude_min, l.parameters.amplitude_max);
+        assert_eq!((l.observed(Side::Inward), l.observed(Side::Outward)), (range, range));
+        let mut v: serde_json::Value = serde_json::from_str(&s).unwrap();
+        v["parameters"]["observed"] = serde_json::json!({"in": [0.02, 0.3], "out": [0.01, 0.05]});
+        let with: RestitutionLaw = serde_json::from_value(v.clone()).unwrap();
+        assert_eq!((with.observed(Side::Inward), with.observed(Side::Outward)), ((0.02, 0.3), (0.01, 0.05)));
+        assert_eq!(
+            serde_json::from_str::<RestitutionLaw>(&serde_json::to_string(&with).unwrap()).unwrap(),
+            with
+        );
+        for bad in [[0.05, 0.01], [0.0, 0.05], [0.01, 1.5]] {
+            v["parameters"]["observed"]["out"] = serde_json::json!(bad);
+            let err = serde_json::from_value::<RestitutionLaw>(v.clone()).map(|_| ()).unwrap_err().to_string();
+            assert!(err.contains("observed amplitudes of side \"out\""), "{bad:?}: {err}");
+        }
     }
 
     /// A two-sided law with the energy term: r∞ 1, c 0.02, c₂ 0.01 over
@@ -844,6 +920,7 @@ mod tests {
                 amplitude_min: 0.04,
                 amplitude_max: 0.4,
                 inward_amplitude_min: None,
+                observed: None,
             },
         }
     }

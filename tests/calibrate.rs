@@ -220,6 +220,7 @@ fn law_test(
                     amplitude_min: 1e-6,
                     amplitude_max: 1.0,
                     inward_amplitude_min: None,
+                    observed: None,
                 },
             };
             ImpactLaw::new(std::sync::Arc::new(law), e_h)

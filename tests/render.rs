@@ -197,6 +197,7 @@ fn run(set: &str, polarity: i8, peak: f64, overturn: Option<f64>, well_condition
         },
         well_conditioned,
         sensitivity: [peak, peak],
+        law_reach: None,
         history: Vec::new(),
     }
 }

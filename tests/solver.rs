@@ -39,7 +39,18 @@ fn impacts(ev: &[Event]) -> Vec<(f64, Side, f64, f64)> {
                 entering,
                 v_before,
                 v_after,
+                ..
             } => Some((t, entering, v_before, v_after)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Each impact's a = apex/α, as its event reports it.
+fn amplitudes(ev: &[Event]) -> Vec<f64> {
+    ev.iter()
+        .filter_map(|e| match *e {
+            Event::Impact { amplitude_over_alpha, .. } => Some(amplitude_over_alpha),
             _ => None,
         })
         .collect()
@@ -347,8 +358,8 @@ fn constant_law_equals_the_constant_pair_bit_for_bit() {
 /// c_k = cos(α(1 − a_k)), the impact leaves e_k² of the kinetic energy,
 /// e_k = r(side, a_k) e_H, and the next apex follows in closed form:
 ///   c_{k+1} = cos α + e_k² (c_k − cos α),   a_{k+1} = 1 − arccos(c_{k+1})/α.
-/// Every impact's v_before, v_after and the energy ratio are checked against this
-/// recursion. Tolerance 1e-8 relative: the integrator runs at rtol 1e-12, events
+/// Every impact's v_before, v_after, the energy ratio and the amplitude its
+/// event reports are checked against this recursion. Tolerance 1e-8 relative: the integrator runs at rtol 1e-12, events
 /// and apexes are located to 1e-13 s on the dense output, and the recursion
 /// carries an error in a_k into e_k with gain dr/da · a/r < 0.5 (the law's slope),
 /// so ten impacts accumulate well under 1e-9; 1e-8 leaves a decade of margin.
@@ -388,6 +399,7 @@ fn free_rocking_under_an_energy_law_follows_the_energy_recursion() {
             amplitude_min: 0.05,
             amplitude_max: 0.3,
             inward_amplitude_min: None,
+            observed: None,
         },
     };
     law.validate().unwrap();
@@ -404,8 +416,11 @@ fn follows_the_energy_recursion<L: rocklab::solver::Restitution + Copy + 'static
     let sim = simulate(&m, &quiet(), 0.0, Some([a0 * ALPHA, 0.0]), &tight(t_end)).unwrap();
     let imp = impacts(&sim.events);
     assert!(imp.len() >= 10, "{} impacts", imp.len());
+    let read_at = amplitudes(&sim.events);
     let mut a = a0;
     for (k, &(_, entering, vb, va)) in imp.iter().take(10).enumerate() {
+        // The amplitude the event reports is the one the law was read at.
+        assert!((read_at[k] / a - 1.0).abs() < 1e-8, "impact {k}: amplitude {} vs {a}", read_at[k]);
         assert_eq!(entering, if k % 2 == 0 { Side::Inward } else { Side::Outward }, "impact {k}");
         let c = (ALPHA * (1.0 - a)).cos();
         let v = (2.0 * P2 * (c - ALPHA.cos())).sqrt();

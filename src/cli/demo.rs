@@ -102,7 +102,11 @@ fn law_sets(study: &rocklab::facade::Study, path: &std::path::Path, name: &str) 
             .ok_or_else(|| anyhow::anyhow!("{}: restitution_law.constant.{k}: expected a number", path.display()))
     };
     if law.form != rocklab::restitution_law::LawForm::Constant {
-        let constant = RestitutionLaw::constant(num("r_in")?, num("r_in_u")?, num("r_out")?, num("r_out_u")?);
+        let mut constant = RestitutionLaw::constant(num("r_in")?, num("r_in_u")?, num("r_out")?, num("r_out_u")?);
+        // The best constant of the same impacts: the same amplitudes observed.
+        constant.parameters.amplitude_min = law.parameters.amplitude_min;
+        constant.parameters.amplitude_max = law.parameters.amplitude_max;
+        constant.parameters.observed = Some(law.observed_amplitudes());
         let source = format!("the constant pair of {}", path.display());
         sets.push(CoefficientSet::law(&format!("{name} constant"), constant, None, alpha, true, source));
     }

@@ -67,6 +67,9 @@ pub fn facade_files(study: &Study, res: &FacadeResults, inputs: &[InputFile]) ->
     }
     tables.push(results_table(study, &res.runs));
     files.add("results.csv", results_csv(study, &res.runs)?);
+    if let Some(t) = law_reach_table(study, &res.runs) {
+        tables.push(t);
+    }
     let mut figs = Figs::default();
     if let Some((source, fits)) = &res.fragility {
         tables.push(fragility_table(study, fits, source));
@@ -133,6 +136,7 @@ fn facade_page(study: &Study, tables: &[Table], figs: &Figs, inputs: &[InputFile
             "ensemble" => "Verdicts with their odds: P(overturn) over the uncertain inputs",
             "results" => "Nominal runs",
             "fragility" => "Fragility curves",
+            "law_reach" => "Where the laws reach beyond their data",
             other => other,
         });
         page.raw(&to_html(t));
@@ -234,6 +238,89 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
         }
     }
     t
+}
+
+/// Per law set and side, where the impacts of its nominal runs (every record
+/// and polarity) fell: the amplitudes the campaign observed on the side and
+/// those the runs read the law at, the impacts, how many below and above the
+/// observed ones, and how many at the cap e = 1. None when no set is a law.
+pub fn law_reach_table(study: &Study, runs: &[StudyRun]) -> Option<Table> {
+    use crate::facade::LawReach;
+    use crate::wall::Side;
+    let alpha = study.block.block.alpha;
+    let laws: Vec<_> = study.sets.iter().filter_map(|s| s.law_at(alpha).map(|(law, _)| (s, law))).collect();
+    if laws.is_empty() {
+        return None;
+    }
+    let r = |k: &str, l: &str| Column::new(k, l, Align::Right);
+    let columns = vec![
+        Column::new("coefficients", "coefficients", Align::Left),
+        Column::new("side", "impacts entering", Align::Left),
+        r("observed", "campaign's a"),
+        r("read", "runs' a"),
+        r("impacts", "impacts"),
+        r("below", "below the data (energy)"),
+        r("above", "above the data (energy)"),
+        r("elastic", "at e = 1"),
+        r("mean_e", "mean e"),
+    ];
+    let caption = "Where each law set's impacts fell in its nominal runs (every record and polarity of the table above), by the side they enter: the amplitudes a = |θ|/α of the campaign's impacts the law was fitted on, those of the runs' impacts, and how many of these ended a half-cycle smaller or larger than any the campaign observed on that side (there the law's coefficient comes from its form, extrapolated or held, not from a measured impact), with in brackets their share of the kinetic energy the side's impacts met (Σ θ'² before impact: most impacts of a run that comes to rest are tiny and carry almost none), or were capped at e = 1 (an elastic impact), and the mean e the side's impacts applied, weighted by that energy. A verdict whose impacts lie beyond the data rests on the law's form there, not on the campaign.".to_string();
+    let mut t = Table::new("law_reach", caption, columns);
+    t.nowrap = true;
+    let share = |n: usize, of: usize| {
+        let text = if of == 0 {
+            "—".to_string()
+        } else {
+            format!("{n} ({:.0} %)", 100.0 * n as f64 / of as f64)
+        };
+        Cell::num(n as f64, text)
+    };
+    let with_energy = |n: usize, of: usize, k: f64, total: f64| {
+        let text = if of == 0 {
+            "—".to_string()
+        } else {
+            format!("{n} ({:.0} %)", 100.0 * k / total.max(f64::MIN_POSITIVE))
+        };
+        Cell::num(n as f64, text)
+    };
+    let a = |x: f64| match x {
+        0.0 => "0".to_string(),
+        x if x >= 0.01 => format!("{x:.3}"),
+        x => format!("{x:.2e}"),
+    };
+    for (set, law) in laws {
+        let mut reach = LawReach::default();
+        runs.iter()
+            .filter(|r| r.coefficients == set.name)
+            .filter_map(|r| r.law_reach.as_ref())
+            .for_each(|x| reach.add(x));
+        for (side, name, x) in [(Side::Inward, "inward", &reach.inward), (Side::Outward, "outward", &reach.outward)] {
+            let (lo, hi) = law.observed(side);
+            let read = if x.impacts == 0 {
+                "—".to_string()
+            } else {
+                format!("{}–{}", a(x.smallest_amplitude), a(x.largest_amplitude))
+            };
+            t.push(
+                Some(format!("{} {name}", set.name)),
+                vec![
+                    Cell::text(&set.name),
+                    Cell::text(name),
+                    Cell::text(format!("{}–{}", a(lo), a(hi))),
+                    Cell::text(read),
+                    Cell::num(x.impacts as f64, x.impacts.to_string()),
+                    with_energy(x.below_observed, x.impacts, x.energy_below, x.energy),
+                    with_energy(x.above_observed, x.impacts, x.energy_above, x.energy),
+                    share(x.elastic, x.impacts),
+                    match x.mean_e() {
+                        Some(e) => Cell::num(e, format!("{e:.3}")),
+                        None => Cell::text("—"),
+                    },
+                ],
+            );
+        }
+    }
+    Some(t)
 }
 
 /// results.csv: per record and polarity, every set's outcome at full precision.

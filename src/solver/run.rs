@@ -128,6 +128,10 @@ pub enum Event {
         entering: Side,
         v_before: f64,
         v_after: f64,
+        /// a = apex/α of the half-cycle the impact ends (max |θ| since the last
+        /// impact, uplift or release, over α): the amplitude at which a law's
+        /// coefficient was read.
+        amplitude_over_alpha: f64,
     },
     /// Rocking started from rest towards `side` (serialised ±1).
     Uplift {
@@ -489,6 +493,7 @@ impl<'a, 'o> Loop<'a, 'o> {
     fn impact(&mut self, from: Side, te: f64, vb: f64, hh: f64) {
         let entering = from.opposite();
         let e = self.model.coefficient(entering, self.apex);
+        let amplitude_over_alpha = self.apex / self.model.alpha;
         self.apex = 0.0;
         let va = e * vb;
         self.push(te, [0.0, vb]);
@@ -498,6 +503,7 @@ impl<'a, 'o> Loop<'a, 'o> {
             entering,
             v_before: vb,
             v_after: va,
+            amplitude_over_alpha,
         });
         self.t = te;
         self.y = [0.0, va];

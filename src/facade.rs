@@ -303,6 +303,16 @@ impl SideReach {
 }
 
 impl LawReach {
+    /// The largest share, over the two sides, of the kinetic energy the
+    /// impacts met that was met beyond the law's data (0 without impacts).
+    pub fn beyond_share(&self) -> f64 {
+        [&self.inward, &self.outward]
+            .iter()
+            .filter(|x| x.energy > 0.0)
+            .map(|x| (x.energy_below + x.energy_above) / x.energy)
+            .fold(0.0, f64::max)
+    }
+
     /// Add another run's counts (the amplitudes' range is the union).
     pub fn add(&mut self, other: &LawReach) {
         for (a, b) in [(&mut self.inward, &other.inward), (&mut self.outward, &other.outward)] {

@@ -591,6 +591,59 @@ fn facade_small_study_end_to_end() {
     }
 }
 
+/// A law set's runs say where their impacts fell against the law's data: a law
+/// observed only at a = 0.9–1 (no run of this pulse reaches it) has every
+/// impact below its data, summary.json's `law_reach` counts them all with their
+/// energy, results.md has the table and marks the set's verdict ‡; the same law
+/// observed over (0, 1] counts none and marks nothing.
+#[test]
+fn facade_law_set_says_where_its_impacts_fall() {
+    for (observed, beyond) in [("[0.9, 1.0]", true), ("[0.000001, 1.0]", false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let law = format!(
+            r#"{{"form": "speed-loss", "parameters": {{
+                "in": {{"r_inf": 0.62, "c": 0.0, "cov": [[0.0001, 0.0], [0.0, 0.0]]}},
+                "out": {{"r_inf": 0.9, "c": 0.01, "cov": [[0.0004, 0.0], [0.0, 0.00001]]}},
+                "shared": false, "amplitude_min": 0.01, "amplitude_max": 0.4,
+                "observed": {{"in": {observed}, "out": {observed}}}}}}}"#
+        );
+        std::fs::write(dir.path().join("law.json"), law).unwrap();
+        let body = SMALL_STUDY.replace("polarities = [1]", "polarities = [1]\nsamples = 4\nseed = 1")
+            + "\n[[coefficients]]\nname = \"lab law\"\nlaw = \"law.json\"\n";
+        let study = write_study(dir.path(), &body);
+        let out = dir.path().join("out");
+        let o = facade(&study, &out, &[]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+        let runs = s["runs"].as_array().unwrap();
+        let lab = runs.iter().find(|r| r["coefficients"] == "lab law").unwrap();
+        assert!(runs
+            .iter()
+            .filter(|r| r["coefficients"] != "lab law")
+            .all(|r| r.get("law_reach").is_none()));
+        let reach = &lab["law_reach"];
+        let total: u64 = ["inward", "outward"].iter().map(|k| reach[k]["impacts"].as_u64().unwrap()).sum();
+        assert_eq!(total, lab["impacts"].as_u64().unwrap(), "{reach}");
+        assert!(total > 0, "the pulse rocks the block: {reach}");
+        for k in ["inward", "outward"] {
+            let side = &reach[k];
+            let (n, below) = (side["impacts"].as_u64().unwrap(), side["below_observed"].as_u64().unwrap());
+            let (energy, energy_below) = (side["energy"].as_f64().unwrap(), side["energy_below"].as_f64().unwrap());
+            if beyond {
+                assert_eq!((below, energy_below), (n, energy), "{k}: {side}");
+            } else {
+                assert_eq!((below, energy_below), (0, 0.0), "{k}: {side}");
+            }
+            assert_eq!(side["above_observed"].as_u64(), Some(0), "{k}: {side}");
+        }
+        let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+        assert!(md.contains("| lab law | outward |"), "{md}");
+        let marked = md.lines().any(|l| l.contains("| lab law |") && l.contains(" ‡ |"));
+        assert_eq!(marked, beyond, "{md}");
+        assert!(!md.lines().any(|l| l.contains("| calibrated |") && l.contains("‡")), "{md}");
+    }
+}
+
 /// Issue #5: the study parser's errors name what is wrong.
 #[test]
 fn facade_study_errors() {

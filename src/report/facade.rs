@@ -504,6 +504,10 @@ fn nominal_of(r: &EnsembleRow, nominal: &[StudyRun]) -> String {
     find_run(nominal, &r.record, &r.coefficients, p).map(outcome_text).unwrap_or_default()
 }
 
+/// The share of one side's impact energy met beyond a law's data above which
+/// the ensembles' table marks a law set's verdict (‡): most of it.
+pub const BEYOND_THE_DATA: f64 = 0.5;
+
 /// The ensembles' table: P(overturn) first with its interval and verdict, the
 /// nominal run last as the numerical check.
 fn ensemble_table(study: &Study, rows: &[EnsembleRow], nominal: &[StudyRun]) -> Table {
@@ -523,10 +527,24 @@ fn ensemble_table(study: &Study, rows: &[EnsembleRow], nominal: &[StudyRun]) -> 
         r("overturn_time_median_s", "median overturning time (s)"),
         r("nominal_run", "nominal run"),
     ];
-    let mut t = Table::new("ensemble", ensemble_caption(study), columns);
+    let mut caption = ensemble_caption(study);
+    let beyond = |row: &EnsembleRow| {
+        row.polarity
+            .and_then(|p| find_run(nominal, &row.record, &row.coefficients, p))
+            .and_then(|r| r.law_reach)
+            .is_some_and(|x| x.beyond_share() > BEYOND_THE_DATA)
+    };
+    if rows.iter().any(beyond) {
+        caption.push_str(&format!(
+            " ‡ a law set whose nominal run met more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side (\"Where the laws reach beyond their data\"): its odds rest on the law's form there, not on measured impacts.",
+            100.0 * BEYOND_THE_DATA
+        ));
+    }
+    let mut t = Table::new("ensemble", caption, columns);
     t.nowrap = true;
     for row in rows {
         let st = &row.stats;
+        let mark = if beyond(row) { " ‡" } else { "" };
         let pol = row.polarity.map_or("random".to_string(), signed);
         t.push(
             Some(format!("{}{}/{}", row.record, pol, row.coefficients)),
@@ -536,7 +554,7 @@ fn ensemble_table(study: &Study, rows: &[EnsembleRow], nominal: &[StudyRun]) -> 
                 Cell::text(&row.coefficients),
                 Cell::num(st.p_overturn, pct(st.p_overturn)).strong(),
                 Cell::text(format!("{}–{}", pct(st.p_overturn_ci95[0]), pct(st.p_overturn_ci95[1]))),
-                Cell::text(st.verdict.to_string()),
+                Cell::text(format!("{}{mark}", st.verdict)),
                 Cell::num(st.max_theta_over_alpha_median, format!("{:.3}", st.max_theta_over_alpha_median)),
                 Cell::text(format!("{:.3}–{:.3}", st.max_theta_over_alpha_p05, st.max_theta_over_alpha_p95)),
                 Cell::text(st.overturn_time_median_s.map_or("—".to_string(), |t| format!("{t:.2}"))),

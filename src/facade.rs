@@ -471,6 +471,10 @@ pub struct SampleRun {
     pub inputs: Inputs,
     #[serde(flatten)]
     pub outcome: Outcome,
+    /// A law set's sample: where its impacts fell against the law's data
+    /// (summed into its ensemble row; not written per sample).
+    #[serde(skip)]
+    pub law_reach: Option<LawReach>,
 }
 
 /// What an ensemble says for one record × polarity row × coefficient set.
@@ -482,6 +486,11 @@ pub struct EnsembleRow {
     pub polarity: Option<i8>,
     #[serde(flatten)]
     pub stats: ensemble::EnsembleStats,
+    /// A law set's row: [`LawReach`] summed over its samples, whose drawn
+    /// inputs (the restraint's contact height, I₀, α) move its impacts'
+    /// amplitudes against the law's data.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law_reach: Option<LawReach>,
 }
 
 /// A job of an ensemble: record, set, polarity row, scale index and factor.
@@ -554,7 +563,8 @@ impl Study {
             atol: self.rtol * 1e-2,
             keep_history: false,
         };
-        let (sum, _) = run(&block, &rec.record, &spec)?;
+        let (sum, sim) = run(&block, &rec.record, &spec)?;
+        let law_reach = spec.law.map(|(law, e_h)| law_reach(&sim.events, &law, e_h));
         Ok(SampleRun {
             record: rec.name.clone(),
             coefficients: set.name.clone(),
@@ -568,6 +578,7 @@ impl Study {
                 overturn_time_s: sum.overturn_time_s,
                 max_theta_over_alpha: sum.max_theta_over_alpha,
             },
+            law_reach,
         })
     }
 
@@ -609,6 +620,10 @@ pub fn run_ensembles(study: &Study, n: usize, tick: &(dyn Fn() + Sync)) -> Resul
             coefficients: study.sets[j.set].name.clone(),
             polarity: j.row.map(|p| p as i8),
             stats: ensemble::summarise(&chunk.iter().map(|s| s.outcome).collect::<Vec<_>>()),
+            law_reach: chunk.iter().filter_map(|s| s.law_reach).reduce(|mut a, b| {
+                a.add(&b);
+                a
+            }),
         })
         .collect();
     Ok((rows, samples))

@@ -594,7 +594,8 @@ fn facade_small_study_end_to_end() {
 /// A law set's runs say where their impacts fell against the law's data: a law
 /// observed only at a = 0.9–1 (no run of this pulse reaches it) has every
 /// impact below its data, summary.json's `law_reach` counts them all with their
-/// energy, results.md has the table and marks the set's verdict ‡; the same law
+/// energy (the nominal run in `runs`, the four samples summed in its ensemble
+/// row), results.md has the table and marks the set's verdict ‡; the same law
 /// observed over (0, 1] counts none and marks nothing.
 #[test]
 fn facade_law_set_says_where_its_impacts_fall() {
@@ -636,8 +637,28 @@ fn facade_law_set_says_where_its_impacts_fall() {
             }
             assert_eq!(side["above_observed"].as_u64(), Some(0), "{k}: {side}");
         }
+        // The ensemble's row sums its samples' reach; the ‡ and the table read it.
+        let rows = s["ensemble"]["rows"].as_array().unwrap();
+        let row = rows.iter().find(|r| r["coefficients"] == "lab law").unwrap();
+        assert!(rows
+            .iter()
+            .filter(|r| r["coefficients"] != "lab law")
+            .all(|r| r.get("law_reach").is_none()));
+        for k in ["inward", "outward"] {
+            let side = &row["law_reach"][k];
+            let (n, below) = (side["impacts"].as_u64().unwrap(), side["below_observed"].as_u64().unwrap());
+            assert_eq!(below, if beyond { n } else { 0 }, "{k}: {side}");
+        }
+        let samples: u64 = ["inward", "outward"]
+            .iter()
+            .map(|k| row["law_reach"][k]["impacts"].as_u64().unwrap())
+            .sum();
+        assert!(samples > 0, "{row}");
         let md = std::fs::read_to_string(out.join("results.md")).unwrap();
-        assert!(md.contains("| lab law | outward |"), "{md}");
+        assert!(
+            md.contains("| lab law | outward |") && md.contains("fell in its ensembles' samples"),
+            "{md}"
+        );
         let marked = md.lines().any(|l| l.contains("| lab law |") && l.contains(" ‡ |"));
         assert_eq!(marked, beyond, "{md}");
         assert!(!md.lines().any(|l| l.contains("| calibrated |") && l.contains("‡")), "{md}");

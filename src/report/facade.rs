@@ -67,7 +67,7 @@ pub fn facade_files(study: &Study, res: &FacadeResults, inputs: &[InputFile]) ->
     }
     tables.push(results_table(study, &res.runs));
     files.add("results.csv", results_csv(study, &res.runs)?);
-    if let Some(t) = law_reach_table(study, &res.runs) {
+    if let Some(t) = law_reach_table(study, &res.runs, res.ensemble.as_ref().map(|(rows, _)| &rows[..])) {
         tables.push(t);
     }
     let mut figs = Figs::default();
@@ -240,11 +240,14 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
     t
 }
 
-/// Per law set and side, where the impacts of its nominal runs (every record
-/// and polarity) fell: the amplitudes the campaign observed on the side and
-/// those the runs read the law at, the impacts, how many below and above the
-/// observed ones, and how many at the cap e = 1. None when no set is a law.
-pub fn law_reach_table(study: &Study, runs: &[StudyRun]) -> Option<Table> {
+/// Per law set and side, where the impacts of its runs fell: those of its
+/// ensembles' samples where the study ran ensembles (where its odds come
+/// from), else those of its nominal runs (every record and polarity): the
+/// amplitudes the campaign observed on the side and those the runs read the
+/// law at, the impacts, how many below and above the observed ones with their
+/// share of the energy, how many at the cap e = 1, and the mean e. None when
+/// no set is a law.
+pub fn law_reach_table(study: &Study, runs: &[StudyRun], ensemble: Option<&[EnsembleRow]>) -> Option<Table> {
     use crate::facade::LawReach;
     use crate::wall::Side;
     let alpha = study.block.block.alpha;
@@ -264,7 +267,13 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun]) -> Option<Table> {
         r("elastic", "at e = 1"),
         r("mean_e", "mean e"),
     ];
-    let caption = "Where each law set's impacts fell in its nominal runs (every record and polarity of the table above), by the side they enter: the amplitudes a = |θ|/α of the campaign's impacts the law was fitted on, those of the runs' impacts, and how many of these ended a half-cycle smaller or larger than any the campaign observed on that side (there the law's coefficient comes from its form, extrapolated or held, not from a measured impact), with in brackets their share of the kinetic energy the side's impacts met (Σ θ'² before impact: most impacts of a run that comes to rest are tiny and carry almost none), or were capped at e = 1 (an elastic impact), and the mean e the side's impacts applied, weighted by that energy. A verdict whose impacts lie beyond the data rests on the law's form there, not on the campaign.".to_string();
+    let from_samples = ensemble.is_some_and(|rows| rows.iter().any(|r| r.law_reach.is_some()));
+    let whose = if from_samples {
+        "in its ensembles' samples (every record and polarity row, each sample with its drawn inputs)"
+    } else {
+        "in its nominal runs (every record and polarity)"
+    };
+    let caption = format!("Where each law set's impacts fell {whose}, by the side they enter:") + " the amplitudes a = |θ|/α of the campaign's impacts the law was fitted on, those of the runs' impacts, and how many of these ended a half-cycle smaller or larger than any the campaign observed on that side (there the law's coefficient comes from its form, extrapolated or held, not from a measured impact), with in brackets their share of the kinetic energy the side's impacts met (Σ θ'² before impact: most impacts of a run that comes to rest are tiny and carry almost none), or were capped at e = 1 (an elastic impact), and the mean e the side's impacts applied, weighted by that energy. A verdict whose impacts lie beyond the data rests on the law's form there, not on the campaign.";
     let mut t = Table::new("law_reach", caption, columns);
     t.nowrap = true;
     let share = |n: usize, of: usize| {
@@ -290,10 +299,19 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun]) -> Option<Table> {
     };
     for (set, law) in laws {
         let mut reach = LawReach::default();
-        runs.iter()
-            .filter(|r| r.coefficients == set.name)
-            .filter_map(|r| r.law_reach.as_ref())
-            .for_each(|x| reach.add(x));
+        let of_set = |name: &str| name == set.name;
+        match ensemble.filter(|_| from_samples) {
+            Some(rows) => rows
+                .iter()
+                .filter(|r| of_set(&r.coefficients))
+                .filter_map(|r| r.law_reach.as_ref())
+                .for_each(|x| reach.add(x)),
+            None => runs
+                .iter()
+                .filter(|r| of_set(&r.coefficients))
+                .filter_map(|r| r.law_reach.as_ref())
+                .for_each(|x| reach.add(x)),
+        }
         for (side, name, x) in [(Side::Inward, "inward", &reach.inward), (Side::Outward, "outward", &reach.outward)] {
             let (lo, hi) = law.observed(side);
             let read = if x.impacts == 0 {
@@ -504,8 +522,9 @@ fn nominal_of(r: &EnsembleRow, nominal: &[StudyRun]) -> String {
     find_run(nominal, &r.record, &r.coefficients, p).map(outcome_text).unwrap_or_default()
 }
 
-/// The share of one side's impact energy met beyond a law's data above which
-/// the ensembles' table marks a law set's verdict (‡): most of it.
+/// The share of one side's impact energy met beyond a law's data (summed over
+/// an ensemble row's samples) above which the ensembles' table marks a law
+/// set's verdict (‡): most of it.
 pub const BEYOND_THE_DATA: f64 = 0.5;
 
 /// The ensembles' table: P(overturn) first with its interval and verdict, the
@@ -528,15 +547,10 @@ fn ensemble_table(study: &Study, rows: &[EnsembleRow], nominal: &[StudyRun]) -> 
         r("nominal_run", "nominal run"),
     ];
     let mut caption = ensemble_caption(study);
-    let beyond = |row: &EnsembleRow| {
-        row.polarity
-            .and_then(|p| find_run(nominal, &row.record, &row.coefficients, p))
-            .and_then(|r| r.law_reach)
-            .is_some_and(|x| x.beyond_share() > BEYOND_THE_DATA)
-    };
+    let beyond = |row: &EnsembleRow| row.law_reach.is_some_and(|x| x.beyond_share() > BEYOND_THE_DATA);
     if rows.iter().any(beyond) {
         caption.push_str(&format!(
-            " ‡ a law set whose nominal run met more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side (\"Where the laws reach beyond their data\"): its odds rest on the law's form there, not on measured impacts.",
+            " ‡ a law set whose samples met, together, more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side (\"Where the laws reach beyond their data\" shows the nominal runs): its odds rest on the law's form there, not on measured impacts.",
             100.0 * BEYOND_THE_DATA
         ));
     }

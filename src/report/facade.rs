@@ -550,7 +550,7 @@ fn ensemble_table(study: &Study, rows: &[EnsembleRow], nominal: &[StudyRun]) -> 
     let beyond = |row: &EnsembleRow| row.law_reach.is_some_and(|x| x.beyond_share() > BEYOND_THE_DATA);
     if rows.iter().any(beyond) {
         caption.push_str(&format!(
-            " ‡ a law set whose samples met, together, more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side (\"Where the laws reach beyond their data\" shows the nominal runs): its odds rest on the law's form there, not on measured impacts.",
+            " ‡ a law set whose samples met, together, more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side (\"Where the laws reach beyond their data\"): its odds rest on the law's form there, not on measured impacts.",
             100.0 * BEYOND_THE_DATA
         ));
     }

@@ -357,9 +357,10 @@ pub fn law_reach(events: &[Event], law: &RestitutionLaw, e_h: f64) -> LawReach {
             side.smallest_amplitude = if side.impacts == 0 { a } else { side.smallest_amplitude.min(a) };
             side.largest_amplitude = side.largest_amplitude.max(a);
             side.impacts += 1;
-            let k = v_before * v_before;
+            let (k, e) = (v_before * v_before, law.e(entering, a, e_h));
             side.energy += k;
-            side.energy_e += k * law.e(entering, a, e_h);
+            side.energy_e += k * e;
+            side.elastic += usize::from(e >= 1.0);
             if a < lo {
                 side.below_observed += 1;
                 side.energy_below += k;
@@ -368,7 +369,6 @@ pub fn law_reach(events: &[Event], law: &RestitutionLaw, e_h: f64) -> LawReach {
                 side.above_observed += 1;
                 side.energy_above += k;
             }
-            side.elastic += usize::from(law.e(entering, a, e_h) >= 1.0);
         }
     }
     reach

@@ -276,42 +276,35 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun], ensemble: Option<&[Ense
     let caption = format!("Where each law set's impacts fell {whose}, by the side they enter:") + " the amplitudes a = |θ|/α of the campaign's impacts the law was fitted on, those of the runs' impacts, and how many of these ended a half-cycle smaller or larger than any the campaign observed on that side (there the law's coefficient comes from its form, extrapolated or held, not from a measured impact), with in brackets their share of the kinetic energy the side's impacts met (Σ θ'² before impact: most impacts of a run that comes to rest are tiny and carry almost none), or were capped at e = 1 (an elastic impact), and the mean e the side's impacts applied, weighted by that energy. A verdict whose impacts lie beyond the data rests on the law's form there, not on the campaign.";
     let mut t = Table::new("law_reach", caption, columns);
     t.nowrap = true;
-    let share = |n: usize, of: usize| {
+    // n of `of` impacts, with a share in brackets (of the impacts or of the energy).
+    let counted = |n: usize, of: usize, share: f64| {
         let text = if of == 0 {
             "—".to_string()
         } else {
-            format!("{n} ({:.0} %)", 100.0 * n as f64 / of as f64)
+            format!("{n} ({:.0} %)", 100.0 * share)
         };
         Cell::num(n as f64, text)
     };
-    let with_energy = |n: usize, of: usize, k: f64, total: f64| {
-        let text = if of == 0 {
-            "—".to_string()
-        } else {
-            format!("{n} ({:.0} %)", 100.0 * k / total.max(f64::MIN_POSITIVE))
-        };
-        Cell::num(n as f64, text)
-    };
+    let ratio = |x: f64, total: f64| x / total.max(f64::MIN_POSITIVE);
     let a = |x: f64| match x {
         0.0 => "0".to_string(),
         x if x >= 0.01 => format!("{x:.3}"),
         x => format!("{x:.2e}"),
     };
+    // Each run's set and reach: the samples' where the study ran ensembles.
+    let reaches: Vec<(&str, &LawReach)> = match ensemble.filter(|_| from_samples) {
+        Some(rows) => rows
+            .iter()
+            .filter_map(|r| Some((r.coefficients.as_str(), r.law_reach.as_ref()?)))
+            .collect(),
+        None => runs
+            .iter()
+            .filter_map(|r| Some((r.coefficients.as_str(), r.law_reach.as_ref()?)))
+            .collect(),
+    };
     for (set, law) in laws {
         let mut reach = LawReach::default();
-        let of_set = |name: &str| name == set.name;
-        match ensemble.filter(|_| from_samples) {
-            Some(rows) => rows
-                .iter()
-                .filter(|r| of_set(&r.coefficients))
-                .filter_map(|r| r.law_reach.as_ref())
-                .for_each(|x| reach.add(x)),
-            None => runs
-                .iter()
-                .filter(|r| of_set(&r.coefficients))
-                .filter_map(|r| r.law_reach.as_ref())
-                .for_each(|x| reach.add(x)),
-        }
+        reaches.iter().filter(|(name, _)| *name == set.name).for_each(|(_, x)| reach.add(x));
         for (side, name, x) in [(Side::Inward, "inward", &reach.inward), (Side::Outward, "outward", &reach.outward)] {
             let (lo, hi) = law.observed(side);
             let read = if x.impacts == 0 {
@@ -327,9 +320,9 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun], ensemble: Option<&[Ense
                     Cell::text(format!("{}–{}", a(lo), a(hi))),
                     Cell::text(read),
                     Cell::num(x.impacts as f64, x.impacts.to_string()),
-                    with_energy(x.below_observed, x.impacts, x.energy_below, x.energy),
-                    with_energy(x.above_observed, x.impacts, x.energy_above, x.energy),
-                    share(x.elastic, x.impacts),
+                    counted(x.below_observed, x.impacts, ratio(x.energy_below, x.energy)),
+                    counted(x.above_observed, x.impacts, ratio(x.energy_above, x.energy)),
+                    counted(x.elastic, x.impacts, ratio(x.elastic as f64, x.impacts as f64)),
                     match x.mean_e() {
                         Some(e) => Cell::num(e, format!("{e:.3}")),
                         None => Cell::text("—"),

@@ -53,6 +53,7 @@ fn facade_run_resting_early_stop(bencher: divan::Bencher, stop: bool) {
         e_in: 0.59,
         e_out: 0.68,
         law: None,
+        law_reading: Default::default(),
         scale: 1.27,
         polarity: -1.0,
         overturn_limit: 0.1,

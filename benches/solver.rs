@@ -31,6 +31,7 @@ fn spec(e_in: f64, e_out: f64, polarity: f64) -> RunSpec {
         e_in,
         e_out,
         law: None,
+        law_reading: Default::default(),
         scale: 1.27,
         polarity,
         overturn_limit: 0.10,

@@ -16,7 +16,7 @@
 //! comparison). Records and sets are keyed by a hash of their names, so
 //! reordering the study file changes nothing.
 
-use crate::restitution_law::RestitutionLaw;
+use crate::restitution_law::{LawReading, RestitutionLaw};
 use crate::stats::{quantile_sorted, sorted, wilson, SplitMix64, Z95};
 use crate::wall::{housner_e, Side};
 
@@ -164,6 +164,8 @@ pub enum CoefficientDist {
         law: RestitutionLaw,
         e_housner: Option<f64>,
         drawn: bool,
+        /// Where the solver reads the law (the apex, or the impact's speed).
+        reading: LawReading,
     },
 }
 
@@ -281,7 +283,7 @@ pub fn draw(key: &SampleKey, unc: &Uncertainty, nominal: &Nominal, set_name: &st
             (v, v, None)
         }
         CoefficientDist::Pair { e_in, e_out } => (e(1, e_in), e(2, e_out), None),
-        CoefficientDist::Law { law, e_housner, drawn } => {
+        CoefficientDist::Law { law, e_housner, drawn, .. } => {
             let e_h = e_housner.unwrap_or_else(|| housner_e(alpha));
             let law = if drawn {
                 let mut rng = key.stream(&[TAG_SET, s, 3]);

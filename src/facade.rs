@@ -13,7 +13,7 @@ use crate::calibrate::CalibrationValues;
 use crate::ensemble::{self, CoefficientDist, Dist, Inputs, Nominal, Outcome, PolarityMode, SampleKey, Uncertainty};
 use crate::fragility::{fit_lognormal, Fragility, FragilityError, Trial};
 use crate::ground_motion::Record;
-use crate::restitution_law::RestitutionLaw;
+use crate::restitution_law::{LawReading, RestitutionLaw};
 use crate::solver::run::{Event, SolverError};
 use crate::solver::BlockSpec;
 use crate::study::{run, RunSpec, RunSummary};
@@ -148,7 +148,28 @@ impl CoefficientSet {
             e_in: law.e(Side::Inward, 1.0, e_h),
             e_out: law.e(Side::Outward, 1.0, e_h),
             source,
-            dist: CoefficientDist::Law { law, e_housner, drawn },
+            dist: CoefficientDist::Law {
+                law,
+                e_housner,
+                drawn,
+                reading: LawReading::Amplitude,
+            },
+        }
+    }
+
+    /// The same law set read as `reading` says (a pair is left as it is).
+    pub fn read_by(mut self, reading: LawReading) -> CoefficientSet {
+        if let CoefficientDist::Law { reading: r, .. } = &mut self.dist {
+            *r = reading;
+        }
+        self
+    }
+
+    /// How a law set reads its law (a pair: by amplitude, which it ignores).
+    pub fn law_reading(&self) -> LawReading {
+        match self.dist {
+            CoefficientDist::Law { reading, .. } => reading,
+            _ => LawReading::Amplitude,
         }
     }
 
@@ -177,6 +198,7 @@ impl Study {
             e_in: set.e_in,
             e_out: set.e_out,
             law: set.law_at(self.block.block.alpha),
+            law_reading: set.law_reading(),
             scale: self.magnification * scale,
             polarity,
             overturn_limit: self.overturn_limit,
@@ -338,13 +360,14 @@ impl LawReach {
 }
 
 /// Count a run's impacts ([`Event::Impact`], each with the amplitude a its
-/// coefficient was read at) against `law` applied with `e_h`.
+/// coefficient was read at: the apex's, or the speed's where the set reads its
+/// law by speed) against `law` applied with `e_h`.
 pub fn law_reach(events: &[Event], law: &RestitutionLaw, e_h: f64) -> LawReach {
     let mut reach = LawReach::default();
     for ev in events {
         if let Event::Impact {
             entering,
-            amplitude_over_alpha: a,
+            law_amplitude_over_alpha: a,
             v_before,
             ..
         } = *ev
@@ -555,6 +578,7 @@ impl Study {
             e_in: x.e_in,
             e_out: x.e_out,
             law: x.law,
+            law_reading: set.law_reading(),
             scale: x.magnification * job.scale,
             polarity: x.polarity,
             overturn_limit: self.overturn_limit_given.unwrap_or(x.alpha),
@@ -739,6 +763,7 @@ mod tests {
             v_before,
             v_after: 0.0,
             amplitude_over_alpha: a,
+            law_amplitude_over_alpha: a,
         };
         let events = [
             imp(Side::Inward, 1.0, 0.001),

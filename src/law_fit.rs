@@ -141,7 +141,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::impacts::ImpactTable;
-use crate::restitution_law::{EnergyLoss, LawForm, LawParameters, ObservedAmplitudes, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
+use crate::restitution_law::{EnergyLoss, LawForm, LawParameters, ObservedAmplitudes, PushSpeed, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
 use crate::wall::{Rocking, Side};
 
 /// Level of the test against a constant (before the Bonferroni split over sides).
@@ -229,6 +229,18 @@ pub struct LawFit {
     /// What the law cannot vouch for, per side ([`notes`]): the amplitudes it was
     /// fitted on, why a side keeps the constant, where it extrapolates.
     pub notes: Vec<String>,
+}
+
+impl LawFit {
+    /// The campaign's [`PushSpeed`] on the law, its speed-loss form and its
+    /// constant pair (one-sided campaigns: the caller knows each test's p, α and
+    /// lever arm, which turn a sensor speed into ŵ = ω⁻/(p α)).
+    pub fn with_push_speed(mut self, push_speed: Option<PushSpeed>) -> LawFit {
+        for law in [&mut self.law, &mut self.speed_loss, &mut self.constant] {
+            law.parameters.push_speed = push_speed;
+        }
+        self
+    }
 }
 
 /// Why no law could be fitted.
@@ -543,6 +555,7 @@ pub fn fit_law(rocking: Rocking, tests: &[TestImpacts]) -> Result<LawFit, LawFit
         amplitude_max: a_max.clamp(a_min.clamp(AMPLITUDE_FLOOR, 1.0), 1.0),
         inward_amplitude_min: (rocking == Rocking::OneSided && inward.c < 0.0).then_some(inward_a_min),
         observed: Some(observed),
+        push_speed: None,
     };
     let speed_loss = RestitutionLaw {
         form: LawForm::SpeedLoss,

@@ -186,6 +186,7 @@ impl LawPacking {
                 amplitude_max: 1.0,
                 inward_amplitude_min: None,
                 observed: None,
+                push_speed: None,
             },
         })
     }
@@ -477,6 +478,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
             amplitude_max: span.1.clamp(span.0.max(AMPLITUDE_FLOOR), 1.0),
             inward_amplitude_min: None,
             observed: None,
+            push_speed: None,
         },
     }
 }

@@ -81,6 +81,29 @@
 //! of its own impacts, `inward_amplitude_min`, where it is given). [`RestitutionLaw::e`]
 //! caps e = r e_H at 1.
 //!
+//! # Reading a law by the impact's speed
+//! The law is written in the amplitude, and the solver reads it at the apex of the
+//! half-cycle an impact ends (SPEC). Its form is a loss of speed, e = e∞ − Δω/ω⁻,
+//! and in free rocking of the test wall ω⁻ follows from the amplitude: on a free
+//! arc ŵ = ω⁻/(p α) = √(a (2 − a)) (small α), after a push ŵ = (Ω/p) a with Ω the
+//! push's angular frequency, which carries the test wall's restraint. On another
+//! wall, or under ground motion, ω⁻ no longer follows from the apex. A façade study
+//! may then read the law at the amplitude whose campaign impact had the same ŵ
+//! ([`LawReading::Speed`], [`RestitutionLaw::amplitude_at_speed`]):
+//! - free arc: a = 1 − arccos(cos α + ŵ² α²/2)/α, the exact inverse of the block's
+//!   free-rocking energy (1 where ŵ exceeds the fall from a = 1), so that in free
+//!   rocking both readings agree;
+//! - push: a = ŵ/(Ω/p)_campaign, with the campaign's median ŵ/a over the outward
+//!   impacts its law was fitted on ([`PushSpeed`], `parameters.push_speed`,
+//!   measured by `reduce` from each impact's speed before and amplitude).
+//!
+//! What it assumes: the lost Δω scales with the wall's own p α (c is dimensionless
+//! in those units), and a push's ŵ/a is one number (on the public one-sided
+//! campaign its 13 pushes give 13.5–18.0 around a median 16.9: the gravity term
+//! and the compliant restraint make it vary). Neither reading can be checked against measured impacts of a façade;
+//! docs/facade.md, "Reading the law by the impact's speed", gives what the choice
+//! does to the demo's verdicts.
+//!
 //! # Uncertainty and draws
 //! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c)
 //! (with the energy term ∇ = (1, −g, −q(g)) and its 3×3 covariance).
@@ -385,6 +408,71 @@ pub struct LawParameters {
     /// beyond its data.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub observed: Option<ObservedAmplitudes>,
+    /// One-sided walls: how fast the campaign's pushes ended for their amplitude,
+    /// ŵ/a with ŵ = ω⁻/(p α) (# Reading a law by the impact's speed). Absent on
+    /// two-sided laws and in laws written before it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub push_speed: Option<PushSpeed>,
+}
+
+/// The dimensionless speed per unit amplitude of a one-sided campaign's pushes,
+/// ŵ/a = ω⁻/(p α a) over its outward impacts (ω⁻ the angular speed before the
+/// impact, p and α the test wall's, a the push's apex |θ|/α): the push's angular
+/// frequency over p, Ω/p, where the transverse walls' spring dominates gravity
+/// (`restitution_law.parameters.push_speed` in summary.json: `{"median": …,
+/// "range": [lo, hi], "impacts": n}`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PushSpeed {
+    pub median: f64,
+    pub range: [f64; 2],
+    pub impacts: usize,
+}
+
+impl PushSpeed {
+    /// From the outward impacts' (amplitude a, ŵ): the median and range of ŵ/a
+    /// over those with a > 0 and ŵ > 0 (None without any).
+    pub fn of(impacts: impl IntoIterator<Item = (f64, f64)>) -> Option<PushSpeed> {
+        let mut q: Vec<f64> = impacts
+            .into_iter()
+            .filter(|(a, w)| *a > 0.0 && *w > 0.0 && a.is_finite() && w.is_finite())
+            .map(|(a, w)| w / a)
+            .collect();
+        q.sort_by(f64::total_cmp);
+        let n = q.len();
+        let median = match n {
+            0 => return None,
+            _ if n % 2 == 1 => q[n / 2],
+            _ => 0.5 * (q[n / 2 - 1] + q[n / 2]),
+        };
+        Some(PushSpeed {
+            median,
+            range: [q[0], q[n - 1]],
+            impacts: n,
+        })
+    }
+}
+
+/// How the solver picks the amplitude at which it reads a law at an impact
+/// (`reading` of a façade study's law set; # Reading a law by the impact's
+/// speed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LawReading {
+    /// At the apex |θ|/α of the half-cycle the impact ends (SPEC; the default).
+    #[default]
+    Amplitude,
+    /// At the amplitude whose campaign impact had the same dimensionless speed
+    /// ŵ = ω⁻/(p α) ([`RestitutionLaw::amplitude_at_speed`]).
+    Speed,
+}
+
+impl LawReading {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LawReading::Amplitude => "amplitude",
+            LawReading::Speed => "speed",
+        }
+    }
 }
 
 /// The amplitudes a = |θ|/α of each side's impacts that a law was fitted on
@@ -448,6 +536,20 @@ pub fn push_shape(a: f64) -> f64 {
     1.0 / a
 }
 
+/// The apex a = |θ|/α of a free-rocking half-cycle that reaches θ = 0 at the
+/// angular speed ŵ p α on a block of slenderness α (paper Eq. 1 without ground
+/// motion: ω² = 2 p² (cos(α − aα) − cos α)): a = 1 − arccos(cos α + ŵ² α²/2)/α,
+/// 1 where ŵ exceeds the fall from a = 1. For small α, a(2 − a) = ŵ², so
+/// g(a) = 1/ŵ ([`speed_shape`]).
+pub fn free_arc_amplitude(speed_over_p_alpha: f64, alpha: f64) -> f64 {
+    let w = speed_over_p_alpha.abs();
+    let x = alpha.cos() + 0.5 * w * w * alpha * alpha;
+    if x >= 1.0 || x.is_nan() {
+        return 1.0;
+    }
+    (1.0 - x.acos() / alpha).max(0.0)
+}
+
 /// The smallest amplitude a law may start at (g(1e-6) ≈ 707).
 pub const AMPLITUDE_FLOOR: f64 = 1e-6;
 
@@ -464,6 +566,7 @@ impl RestitutionLaw {
                 amplitude_max: 1.0,
                 inward_amplitude_min: None,
                 observed: None,
+                push_speed: None,
             },
         }
     }
@@ -539,6 +642,37 @@ impl RestitutionLaw {
             inward: [a, b],
             outward: [c, d],
         }
+    }
+
+    /// Whether `side`'s impacts end a push against the transverse walls (the
+    /// outward side of a one-sided law: its shape is the push's, or the law
+    /// carries the campaign's [`PushSpeed`]).
+    pub fn ends_a_push(&self, side: Side) -> bool {
+        side == Side::Outward && (self.parameters.push_speed.is_some() || self.parameters.outward.g == Shape::Push)
+    }
+
+    /// The amplitude at which a law read by speed is read for an impact entering
+    /// `side` at the dimensionless speed ŵ = ω⁻/(p α) on a block of slenderness
+    /// `alpha` (# Reading a law by the impact's speed): on a free arc, the apex
+    /// whose free rocking reaches θ = 0 at that speed,
+    /// a = 1 − arccos(cos α + ŵ² α²/2)/α (1 where ŵ exceeds the fall from a = 1);
+    /// after a push, a = ŵ/(Ω/p) with the campaign's [`PushSpeed`] median (at
+    /// most 1). None for a push side without it (a law written before it).
+    pub fn amplitude_at_speed(&self, side: Side, speed_over_p_alpha: f64, alpha: f64) -> Option<f64> {
+        let w = speed_over_p_alpha.abs();
+        if self.ends_a_push(side) {
+            return self.parameters.push_speed.map(|q| (w / q.median).min(1.0));
+        }
+        Some(free_arc_amplitude(w, alpha))
+    }
+
+    /// Whether the law can be read by speed: a push side needs the campaign's
+    /// [`PushSpeed`].
+    pub fn readable_by_speed(&self) -> Result<(), String> {
+        if self.ends_a_push(Side::Outward) && self.parameters.push_speed.is_none() {
+            return Err("its outward side ends pushes, and it carries no parameters.push_speed (the campaign's Ω/p, written by rocklab reduce since the fifty-seventh session): reduce the campaign again, or read it by amplitude".into());
+        }
+        Ok(())
     }
 
     /// The coefficient the solver applies: e = min(1, r(a) e_H).
@@ -653,6 +787,15 @@ impl RestitutionLaw {
                 }
             }
         }
+        if let Some(q) = p.push_speed {
+            let [lo, hi] = q.range;
+            if !(q.median.is_finite() && hi.is_finite() && 0.0 < lo && lo <= q.median && q.median <= hi && q.impacts >= 1) {
+                return Err(format!(
+                    "restitution law: push_speed (median {}, range [{lo}, {hi}], {} impacts) must satisfy 0 < lo ≤ median ≤ hi and at least one impact",
+                    q.median, q.impacts
+                ));
+            }
+        }
         if self.form == LawForm::Constant && (p.inward.c != 0.0 || p.outward.c != 0.0) {
             return Err("restitution law: form \"constant\" needs c = 0 on both sides".into());
         }
@@ -693,6 +836,7 @@ mod tests {
                 amplitude_max: 0.391,
                 inward_amplitude_min: None,
                 observed: None,
+                push_speed: None,
             },
         };
         let l = law(LawForm::SpeedLoss, side(0.6714, 0.0), side(1.1614, 0.0415));
@@ -730,6 +874,7 @@ mod tests {
                 amplitude_max: 0.4,
                 inward_amplitude_min: None,
                 observed: None,
+                push_speed: None,
             },
         }
     }
@@ -921,6 +1066,7 @@ mod tests {
                 amplitude_max: 0.4,
                 inward_amplitude_min: None,
                 observed: None,
+                push_speed: None,
             },
         }
     }
@@ -1014,5 +1160,72 @@ mod tests {
         v["parameters"]["out"] = v["parameters"]["in"].clone();
         let err = serde_json::from_value::<RestitutionLaw>(v).unwrap_err().to_string();
         assert!(err.contains("positive semi-definite"), "{err}");
+    }
+
+    /// The free arc's inverse: a block released from a·α reaches θ = 0 at
+    /// ω² = 2 p² (cos(α − aα) − cos α) (Eq. 1 without ground motion, energy);
+    /// read by that speed, the amplitude is a again, to 1e-9 of it, for slender
+    /// and stocky blocks and from tiny swings to a = 1; faster than the fall from
+    /// a = 1, it is 1.
+    #[test]
+    fn the_free_arc_read_by_its_speed_gives_its_apex() {
+        for alpha in [0.03f64, 0.1, 0.1325, 0.25, 0.5] {
+            for a in [1e-5f64, 1e-3, 0.02, 0.3, 0.77, 0.999, 1.0] {
+                let w = (2.0 * ((alpha - a * alpha).cos() - alpha.cos())).sqrt() / alpha;
+                let back = free_arc_amplitude(w, alpha);
+                assert!((back - a).abs() <= 1e-9 * a.max(1e-3), "α {alpha}, a {a}: {back}");
+                // The small-α form the law is written in: g(a) = 1/ŵ.
+                if alpha <= 0.1 {
+                    assert!((speed_shape(a) * w - 1.0).abs() < 0.01, "α {alpha}, a {a}");
+                }
+            }
+            assert_eq!(free_arc_amplitude(1e3, alpha), 1.0);
+            assert!(free_arc_amplitude(-0.0, alpha) < 1e-12);
+        }
+    }
+
+    /// A one-sided law reads its push side at ŵ/(Ω/p) and its inward side on the
+    /// free arc; two-sided laws read both on the free arc; a push side without
+    /// the campaign's Ω/p cannot be read by speed, and says why.
+    #[test]
+    fn a_push_is_read_at_the_campaign_push_of_the_same_speed() {
+        let q = PushSpeed::of([(0.25, 4.25), (0.5, 7.5), (0.25, 4.5), (0.0, 1.0), (0.02, f64::NAN)]).unwrap();
+        assert_eq!((q.median, q.range, q.impacts), (17.0, [15.0, 18.0], 3));
+        assert_eq!(PushSpeed::of([(0.01, 0.1), (0.02, 0.3)]).unwrap().median, 12.5);
+        assert!(PushSpeed::of([(0.0, 0.1)]).is_none());
+        let mut l = RestitutionLaw::constant(0.6, 0.01, 0.9, 0.01);
+        l.form = LawForm::SpeedLoss;
+        l.parameters.outward = SideLaw {
+            r_inf: 1.03,
+            c: 0.0016,
+            cov: [[0.0; 2]; 2],
+            g: Shape::Push,
+            energy: None,
+        };
+        assert!(l.ends_a_push(Side::Outward) && !l.ends_a_push(Side::Inward));
+        let err = l.readable_by_speed().unwrap_err();
+        assert!(err.contains("push_speed"), "{err}");
+        assert_eq!(l.amplitude_at_speed(Side::Outward, 0.2, 0.1), None);
+        l.parameters.push_speed = Some(q);
+        l.validate().unwrap();
+        l.readable_by_speed().unwrap();
+        assert_eq!(l.amplitude_at_speed(Side::Outward, 4.25, 0.1), Some(0.25));
+        assert_eq!(l.amplitude_at_speed(Side::Outward, 100.0, 0.1), Some(1.0));
+        assert_eq!(l.amplitude_at_speed(Side::Inward, 0.5, 0.1), Some(free_arc_amplitude(0.5, 0.1)));
+        // A constant outward side of a one-sided law is still a push (its Ω/p says so).
+        let mut c = RestitutionLaw::constant(0.6, 0.01, 0.9, 0.01);
+        assert!(!c.ends_a_push(Side::Outward));
+        c.readable_by_speed().unwrap();
+        c.parameters.push_speed = Some(q);
+        assert!(c.ends_a_push(Side::Outward));
+        // JSON: written and read back; refused out of order, with the key named.
+        let s = serde_json::to_string(&l).unwrap();
+        assert!(s.contains("\"push_speed\":{\"median\":17.0,\"range\":[15.0,18.0],\"impacts\":3}"), "{s}");
+        assert_eq!(serde_json::from_str::<RestitutionLaw>(&s).unwrap(), l);
+        for bad in ["[18.5,19.0]", "[0.0,18.0]", "[-15.0,18.0]"] {
+            let b = s.replace("[15.0,18.0]", bad);
+            let err = serde_json::from_str::<RestitutionLaw>(&b).map(|_| ()).unwrap_err().to_string();
+            assert!(err.contains("push_speed"), "{bad}: {err}");
+        }
     }
 }

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::ground_motion::Record;
-use crate::restitution_law::RestitutionLaw;
+use crate::restitution_law::{LawReading, RestitutionLaw};
 use crate::solver::run::SolverError;
 use crate::solver::{simulate, BlockSpec, Ground, ImpactLaw, RockingModel, Settings, Simulation, Stop};
 
@@ -15,6 +15,8 @@ pub struct RunSpec {
     pub e_out: f64,
     /// A restitution law and the e_H it is applied with, instead of (e_in, e_out).
     pub law: Option<(RestitutionLaw, f64)>,
+    /// Where the solver reads the law: at the apex (SPEC) or at the impact's speed.
+    pub law_reading: LawReading,
     /// Magnification × user scale.
     pub scale: f64,
     /// ±1.
@@ -75,7 +77,7 @@ pub fn model(block: &BlockSpec, spec: &RunSpec) -> RockingModel {
         ties: block.ties.clone(),
         e_in: spec.e_in,
         e_out: spec.e_out,
-        law: spec.law.map(|(law, e_h)| ImpactLaw::new(Arc::new(law), e_h)),
+        law: spec.law.map(|(law, e_h)| ImpactLaw::new(Arc::new(law), e_h).read_by(spec.law_reading)),
         overturn_limit: spec.overturn_limit,
         linearized: false,
     }

@@ -221,6 +221,7 @@ fn law_test(
                     amplitude_max: 1.0,
                     inward_amplitude_min: None,
                     observed: None,
+                    push_speed: None,
                 },
             };
             ImpactLaw::new(std::sync::Arc::new(law), e_h)

@@ -665,6 +665,64 @@ fn facade_law_set_says_where_its_impacts_fall() {
     }
 }
 
+/// A law set read by the impact's speed (`reading = "speed"`): its outward
+/// side ends pushes, read at ŵ/(Ω/p) with the campaign's Ω/p
+/// (`parameters.push_speed`). With Ω/p = 10⁶ every outward impact reads the law
+/// below 10⁻⁶ (ŵ < 1 on this pulse): all below its data, where the same law
+/// read by amplitude, observed over (0, 1], has none. The set says how it is
+/// read; a law without Ω/p, an unknown reading and a reading on a pair are
+/// refused with the set named.
+#[test]
+fn facade_law_set_read_by_speed() {
+    let dir = tempfile::tempdir().unwrap();
+    let law = |push_speed: &str| {
+        format!(
+            r#"{{"form": "speed-loss", "parameters": {{
+            "in": {{"r_inf": 0.62, "c": 0.0, "cov": [[0.0001, 0.0], [0.0, 0.0]]}},
+            "out": {{"r_inf": 0.9, "c": 0.0001, "cov": [[0.0004, 0.0], [0.0, 1e-10]], "g": "push"}},
+            "shared": false, "amplitude_min": 0.000001, "amplitude_max": 1.0,
+            "observed": {{"in": [0.000001, 1.0], "out": [0.000001, 1.0]}}{push_speed}}}}}"#
+        )
+    };
+    let with = r#", "push_speed": {"median": 1000000.0, "range": [1000000.0, 1000000.0], "impacts": 4}"#;
+    std::fs::write(dir.path().join("law.json"), law(with)).unwrap();
+    std::fs::write(dir.path().join("old.json"), law("")).unwrap();
+    let sets = "\n[[coefficients]]\nname = \"by a\"\nlaw = \"law.json\"\n\n[[coefficients]]\nname = \"by speed\"\nlaw = \"law.json\"\nreading = \"speed\"\n";
+    let study = write_study(dir.path(), &(SMALL_STUDY.to_string() + sets));
+    let out = dir.path().join("out");
+    let o = facade(&study, &out, &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let run = |name: &str| s["runs"].as_array().unwrap().iter().find(|r| r["coefficients"] == name).unwrap().clone();
+    let (by_a, by_speed) = (run("by a"), run("by speed"));
+    let out_a = &by_a["law_reach"]["outward"];
+    let out_w = &by_speed["law_reach"]["outward"];
+    assert!(out_w["impacts"].as_u64().unwrap() > 0, "the pulse rocks the block outward: {out_w}");
+    assert_eq!(out_a["below_observed"].as_u64(), Some(0), "{out_a}");
+    assert_eq!(out_w["below_observed"], out_w["impacts"], "{out_w}");
+    assert!(out_w["largest_amplitude"].as_f64().unwrap() < 1e-6, "{out_w}");
+    for run in [&by_a, &by_speed] {
+        assert_eq!(run["law_reach"]["inward"]["below_observed"].as_u64(), Some(0), "{run}");
+    }
+    let md = std::fs::read_to_string(out.join("results.md")).unwrap();
+    assert!(
+        md.lines().any(|l| l.contains("by speed") && l.contains("read by the impact's speed")),
+        "{md}"
+    );
+    assert!(!md.lines().any(|l| l.contains("**by a**") && l.contains("read by the impact's speed")), "{md}");
+    let cases = [
+        (sets.replace("law = \"law.json\"\nreading", "law = \"old.json\"\nreading"), "\"by speed\": reading = \"speed\": law old.json"),
+        (sets.replace("reading = \"speed\"", "reading = \"sideways\""), "expected \"amplitude\" or \"speed\""),
+        ("\n[[coefficients]]\nname = \"pair\"\ne = 0.9\nreading = \"speed\"\n".to_string(), "reading is for a set with a law"),
+    ];
+    for (sets, expect) in cases {
+        let study = write_study(dir.path(), &(SMALL_STUDY.to_string() + &sets));
+        let o = facade(&study, &dir.path().join("o"), &[]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "expected {expect:?} in {err}");
+    }
+}
+
 /// Issue #5: the study parser's errors name what is wrong.
 #[test]
 fn facade_study_errors() {

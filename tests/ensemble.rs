@@ -137,6 +137,7 @@ fn early_stop_at_rest_changes_no_result() {
                         e_in: set.e_in,
                         e_out: set.e_out,
                         law: None,
+                        law_reading: Default::default(),
                         scale,
                         polarity: pol,
                         overturn_limit: 0.1,
@@ -259,7 +260,12 @@ fn law_draws_follow_the_seed_and_the_sample() {
         scale: 0,
         sample,
     };
-    let set = |drawn: bool| CoefficientDist::Law { law, e_housner: None, drawn };
+    let set = |drawn: bool| CoefficientDist::Law {
+        law,
+        e_housner: None,
+        drawn,
+        reading: Default::default(),
+    };
     assert!(set(true).is_random() && !set(false).is_random());
     let a = draw(&key(1), &unc, &nominal, "law", &set(true), Some(1.0));
     assert_eq!(a, draw(&key(1), &unc, &nominal, "law", &set(true), Some(1.0)));

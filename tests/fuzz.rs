@@ -346,6 +346,7 @@ fn spec() -> RunSpec {
         e_in: 0.9,
         e_out: 0.9,
         law: None,
+        law_reading: Default::default(),
         scale: 1.0,
         polarity: 1.0,
         overturn_limit: 0.1,

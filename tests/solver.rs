@@ -400,6 +400,7 @@ fn free_rocking_under_an_energy_law_follows_the_energy_recursion() {
             amplitude_max: 0.3,
             inward_amplitude_min: None,
             observed: None,
+            push_speed: None,
         },
     };
     law.validate().unwrap();
@@ -433,4 +434,95 @@ fn follows_the_energy_recursion<L: rocklab::solver::Restitution + Copy + 'static
         a = 1.0 - c_next.acos() / ALPHA;
     }
     a
+}
+
+/// Each impact's (entering, apex a, the a the law was read at, v_before, v_after).
+fn readings(ev: &[Event]) -> Vec<(Side, f64, f64, f64, f64)> {
+    ev.iter()
+        .filter_map(|e| match *e {
+            Event::Impact {
+                entering,
+                amplitude_over_alpha,
+                law_amplitude_over_alpha,
+                v_before,
+                v_after,
+                ..
+            } => Some((entering, amplitude_over_alpha, law_amplitude_over_alpha, v_before, v_after)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A law read by the impact's speed (a façade study's `reading = "speed"`).
+///
+/// Free arcs: in free rocking the speed at θ = 0 is the apex's by energy,
+/// ω² = 2p² (cos(α − aα) − cos α), so a two-sided law read by speed is read at
+/// every impact's apex and the run is the amplitude reading's. Tolerance 1e-9
+/// relative: the crossing speed is integrated to rtol 1e-12, and inverting the
+/// energy for a multiplies its error by at most 2 (a ≥ 1e-3 here).
+///
+/// Pushes: one-sided free rocking against a restraint k_θ (I₀ = 1, Ω² = k_θ):
+/// a push of apex a ends at ŵ² = 2 (cos(α − aα) − cos α)/α² + (Ω/p)² a² (the
+/// energy with the spring), and the law's outward side is read at
+/// ŵ/(Ω/p)_campaign, the campaign's median given in `push_speed`; its inward
+/// impacts end free arcs and are read at their apex. Each e is the law's at the
+/// a read. Same tolerance.
+#[test]
+fn a_law_read_by_speed_reads_free_arcs_at_their_apex_and_pushes_at_their_speed() {
+    use rocklab::restitution_law::{LawForm, LawReading, PushSpeed, RestitutionLaw, Shape, SideLaw};
+    let free = SideLaw {
+        r_inf: 0.98,
+        c: 0.04,
+        cov: [[0.0; 2]; 2],
+        g: Shape::Free,
+        energy: None,
+    };
+    let mut two_sided = RestitutionLaw::constant(0.9, 0.0, 0.9, 0.0);
+    two_sided.form = LawForm::SpeedLoss;
+    (two_sided.parameters.inward, two_sided.parameters.outward, two_sided.parameters.shared) = (free, free, true);
+    two_sided.validate().unwrap();
+    let run = |m: &RockingModel| simulate(m, &quiet(), 0.0, Some([0.8 * ALPHA, 0.0]), &tight(8.0)).unwrap();
+    let by_amplitude = run(&with_law(two_sided, 0.95));
+    let mut m = with_law(two_sided, 0.95);
+    m.law = m.law.map(|l| l.read_by(LawReading::Speed));
+    let by_speed = run(&m);
+    let (x, y) = (readings(&by_amplitude.events), readings(&by_speed.events));
+    assert!(y.len() >= 10 && y.iter().take(10).all(|i| i.1 > 1e-3), "{y:?}");
+    for (k, (p, q)) in x.iter().zip(&y).take(10).enumerate() {
+        assert!((q.2 / q.1 - 1.0).abs() < 1e-9, "impact {k}: read at {} for apex {}", q.2, q.1);
+        assert!((q.3 / p.3 - 1.0).abs() < 1e-9 && (q.4 / p.4 - 1.0).abs() < 1e-9, "impact {k}: {p:?} vs {q:?}");
+    }
+
+    let (k_theta, q_campaign) = (60.0, 9.0);
+    let mut one_sided = RestitutionLaw::constant(0.95, 0.0, 0.9, 0.0);
+    one_sided.form = LawForm::SpeedLoss;
+    one_sided.parameters.outward = SideLaw {
+        r_inf: 1.03,
+        c: 0.002,
+        g: Shape::Push,
+        ..free
+    };
+    one_sided.parameters.push_speed = Some(PushSpeed {
+        median: q_campaign,
+        range: [q_campaign, q_campaign],
+        impacts: 1,
+    });
+    one_sided.validate().unwrap();
+    let mut m = with_law(one_sided, 0.95);
+    m.law = m.law.map(|l| l.read_by(LawReading::Speed));
+    m.restraint = Restraint::Rotational { k_nm_per_rad: k_theta };
+    let sim = simulate(&m, &quiet(), 0.0, Some([0.8 * ALPHA, 0.0]), &tight(6.0)).unwrap();
+    let imp = readings(&sim.events);
+    let pushes = imp.iter().filter(|i| i.0 == Side::Outward && i.1 > 1e-3).count();
+    assert!(pushes >= 4, "{imp:?}");
+    for (k, &(side, a, read, vb, va)) in imp.iter().enumerate().filter(|(_, i)| i.1 > 1e-3) {
+        let gravity = 2.0 * ((ALPHA - a * ALPHA).cos() - ALPHA.cos()) / (ALPHA * ALPHA);
+        let want = match side {
+            Side::Outward => (gravity + k_theta / P2 * a * a).sqrt() / q_campaign,
+            Side::Inward => a,
+        };
+        assert!((read / want - 1.0).abs() < 1e-9, "impact {k} ({side:?}): read at {read}, want {want} (apex {a})");
+        let e = one_sided.e(side, read, 0.95);
+        assert!((va / vb / e - 1.0).abs() < 1e-9, "impact {k}: e {} vs {e}", va / vb);
+    }
 }

@@ -374,6 +374,7 @@ def simulate(
     history: bool = True,
     law: Union[None, PathLike, Mapping] = None,
     e_h: Optional[float] = None,
+    law_reading: Optional[str] = None,
 ) -> SimulationResult:
     """Rocking response of a block to a record, as ``rocklab simulate``.
 
@@ -395,6 +396,10 @@ def simulate(
             that ends; ``summary["law"]`` holds it, and ``e_in``/``e_out`` are then
             the law's e at a = 1.
         e_h: the e_H a law's r is multiplied by (default: Eq. 2 with the block's α).
+        law_reading: ``"amplitude"`` (default: the apex, as above) or ``"speed"``:
+            each impact reads the law at the amplitude of the campaign's impacts of
+            its dimensionless speed ŵ = |θ'|/(p α) (docs/facade.md, "Reading the
+            law by the impact's speed"); ``summary["law"]["reading"]`` says which.
     """
     law_path, law_json = _law_args(law)
     block_path, block_json = _block_args(block)
@@ -421,6 +426,7 @@ def simulate(
         law_path=law_path,
         law_json=law_json,
         e_h=e_h,
+        law_reading=law_reading,
     )
     return SimulationResult(json.loads(text), _arrays(raw) if history else {})
 

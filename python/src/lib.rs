@@ -25,7 +25,7 @@ use rocklab::ingest::{Campaign, LogData};
 use rocklab::peaks::{Method, PeakOptions};
 use rocklab::reduce::{campaign_result, reduce_campaign, reduce_loaded, CampaignResult};
 use rocklab::report::{docs, summary::summary, tables};
-use rocklab::restitution_law::RestitutionLaw;
+use rocklab::restitution_law::{LawReading, RestitutionLaw};
 use rocklab::signal::savgol::SavGol;
 use rocklab::solver::block::ImpactDefaults;
 use rocklab::study::{run, RunSpec};
@@ -261,7 +261,8 @@ fn check_e(name: &str, e: f64) -> anyhow::Result<f64> {
 #[pyfunction]
 #[pyo3(signature = (block_path=None, block_json=None, record_path=None, acc=None, format=None, dt=None, units=None,
                     scale=1.0, polarity=1, e=None, e_in=None, e_out=None, calibration=None, overturn_limit=None,
-                    t_extra=0.0, rtol=1e-8, atol=1e-10, history=true, law_path=None, law_json=None, e_h=None))]
+                    t_extra=0.0, rtol=1e-8, atol=1e-10, history=true, law_path=None, law_json=None, e_h=None,
+                    law_reading=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -286,6 +287,7 @@ fn simulate<'py>(
     law_path: Option<PathBuf>,
     law_json: Option<String>,
     e_h: Option<f64>,
+    law_reading: Option<String>,
 ) -> PyResult<(String, Bound<'py, PyDict>)> {
     let acc = acc.map(|a| a.to_vec());
     let (doc, s) = guarded(py, move || {
@@ -293,6 +295,7 @@ fn simulate<'py>(
         let (record_name, record) = load_record(record_path, acc, format, dt, units)?;
         let d = block.impact;
         let law = load_law(law_path, law_json, e_h, block.block.alpha)?;
+        let law_reading = law_reading_of(law_reading.as_deref(), law.as_ref().map(|l| &l.0))?;
         if law.is_some() && (calibration.is_some() || e.is_some() || e_in.is_some() || e_out.is_some()) {
             bail!("give a law, or e, or e_in with e_out, or calibration: not several");
         }
@@ -305,6 +308,7 @@ fn simulate<'py>(
             e_in,
             e_out,
             law,
+            law_reading,
             scale,
             polarity: polarity as f64,
             overturn_limit: overturn_limit.or(d.overturn_limit_rad).unwrap_or(block.block.alpha),
@@ -318,7 +322,7 @@ fn simulate<'py>(
         let mut doc = docs::simulate_summary(&block, &record_name, &record, &spec, &summary, &sim)?;
         if let Some((l, e_h)) = law {
             // e_in and e_out of the document are then the law's e at a = 1.
-            doc["law"] = json!({"law": l, "e_housner": e_h});
+            doc["law"] = json!({"law": l, "e_housner": e_h, "reading": law_reading.as_str()});
         }
         let alpha = block.block.alpha;
         let h = &sim.history;
@@ -354,6 +358,22 @@ fn load_law(path: Option<PathBuf>, json_text: Option<String>, e_h: Option<f64>, 
         None => rocklab::wall::housner_e(alpha),
     };
     Ok(Some((law, e_h)))
+}
+
+/// Where `simulate` reads a law: "amplitude" (default) or "speed" (a law whose
+/// outward side ends pushes needs the campaign's Ω/p for it).
+fn law_reading_of(reading: Option<&str>, law: Option<&RestitutionLaw>) -> anyhow::Result<LawReading> {
+    let r = match reading {
+        None | Some("amplitude") => LawReading::Amplitude,
+        Some("speed") => LawReading::Speed,
+        Some(o) => bail!("law_reading = {o:?}: expected \"amplitude\" or \"speed\""),
+    };
+    match law {
+        None if reading.is_some() => bail!("law_reading is for a law"),
+        Some(l) if r == LawReading::Speed => l.readable_by_speed().map_err(|why| anyhow::anyhow!("law_reading = \"speed\": the law: {why}"))?,
+        _ => {}
+    }
+    Ok(r)
 }
 
 /// The constant pair of `simulate`: a calibration, e, e_in with e_out, or the

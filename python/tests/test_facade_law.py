@@ -101,3 +101,26 @@ def test_an_energy_term_of_zero_is_the_speed_loss_law_bit_for_bit():
     assert zero["law"]["law"]["form"] == "speed-and-energy-loss"
     lossy = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=with_energy(1e-3))
     assert not np.array_equal(lossy.history["theta_rad"], plain.history["theta_rad"])
+
+
+def test_a_law_read_by_speed():
+    """law_reading="speed": each impact reads the law at the amplitude of the
+    campaign's impacts of its speed. A law whose outward side ends pushes needs
+    the campaign's Ω/p (push_speed); the summary says how the law was read. With
+    Ω/p so large that every outward impact reads the push law at the floor, the
+    push law takes all the outward speed (r = 0 there): the run differs from the
+    amplitude reading's."""
+    law = json.loads(LAW.read_text())
+    law["parameters"]["out"]["g"] = "push"
+    with pytest.raises(rocklab.RocklabError, match="push_speed"):
+        rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="speed")
+    with pytest.raises(rocklab.RocklabError, match="expected"):
+        rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="sideways")
+    with pytest.raises(rocklab.RocklabError, match="law_reading is for a law"):
+        rocklab.simulate(BLOCK, NRC_1030, scale=1.27, e=0.9, law_reading="speed")
+    law["parameters"]["push_speed"] = {"median": 1e9, "range": [1e9, 1e9], "impacts": 1}
+    by_a = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, history=False)
+    by_w = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="speed", history=False)
+    assert (by_a["law"]["reading"], by_w["law"]["reading"]) == ("amplitude", "speed")
+    assert by_a["impacts"] > 2
+    assert by_w["max_theta_over_alpha"] != by_a["max_theta_over_alpha"]

@@ -36,6 +36,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     for (campaign, name) in [("one-sided-demo", "campaign"), ("mujoco-public-one-sided", "mujoco")] {
         study.sets.extend(law_sets(&study, &args.out.join(campaign).join("summary.json"), name)?);
     }
+    // The engine-made campaign's law read by the impact's speed as well: its push
+    // law carries the test wall's restraint in its amplitude (docs/facade.md,
+    // "Reading the law by the impact's speed").
+    let readable = |s: &&rocklab::facade::CoefficientSet| s.law_at(study.block.block.alpha).is_some_and(|(law, _)| law.readable_by_speed().is_ok());
+    if let Some(law_set) = study.sets.iter().find(|s| s.name == "mujoco law").filter(readable) {
+        let mut by_speed = law_set.clone().read_by(rocklab::restitution_law::LawReading::Speed);
+        by_speed.name = "mujoco law by speed".into();
+        by_speed.source.push_str(", read by the impact's speed");
+        study.sets.push(by_speed);
+    }
     // The law the engine's own per-impact truth gives (what the readings would give
     // if they reached every impact; tests/law.rs writes and checks it).
     let truth_law = args.fixtures.join("laws").join("mujoco-public-one-sided-truth.json");
@@ -107,6 +117,7 @@ fn law_sets(study: &rocklab::facade::Study, path: &std::path::Path, name: &str) 
         constant.parameters.amplitude_min = law.parameters.amplitude_min;
         constant.parameters.amplitude_max = law.parameters.amplitude_max;
         constant.parameters.observed = Some(law.observed_amplitudes());
+        constant.parameters.push_speed = law.parameters.push_speed;
         let source = format!("the constant pair of {}", path.display());
         sets.push(CoefficientSet::law(&format!("{name} constant"), constant, None, alpha, true, source));
     }

@@ -124,6 +124,7 @@ fn spec_from_args(a: &SimulateArgs, block: &BlockSpec) -> anyhow::Result<RunSpec
         e_in,
         e_out,
         law: None,
+        law_reading: Default::default(),
         scale: a.scale,
         polarity: a.polarity as f64,
         overturn_limit,

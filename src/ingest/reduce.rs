@@ -14,6 +14,8 @@ use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::LogReader;
 use crate::law_fit::{fit_law, LawFit, LawFitError, TestImpacts};
 use crate::peaks::{ContactModel, Method, Onset, PeakOptions, Physics};
+use crate::restitution_law::PushSpeed;
+use crate::wall::{Rocking, Side};
 pub use crate::reduction::{LogData, ReduceError, Reduced};
 
 /// Why a test of a campaign has no coefficients.
@@ -214,8 +216,31 @@ fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, La
             (t.spec.id.as_str(), table)
         })
         .collect();
+    let push_speed = (campaign.rocking == Rocking::OneSided).then(|| campaign_push_speed(campaign, tests)).flatten();
     let used: Vec<TestImpacts> = used.iter().map(|(id, table)| TestImpacts { id, table }).collect();
-    fit_law(campaign.rocking, &used)
+    fit_law(campaign.rocking, &used).map(|fit| fit.with_push_speed(push_speed))
+}
+
+/// Ω/p of a one-sided campaign's pushes ([`PushSpeed`]): ŵ/a of the outward
+/// impacts the law is fitted on, ŵ = v/(L p α) with v the sensor's speed before
+/// the impact, L the test's lever arm and p, α the wall's rocking part.
+fn campaign_push_speed(campaign: &Campaign, tests: &[TestOutcome]) -> Option<PushSpeed> {
+    let part = campaign.wall().rocking_part();
+    let p_alpha = part.p_squared().sqrt() * part.slenderness();
+    let pushes = tests
+        .iter()
+        .filter(|t| !t.spec.exclude_from_mean)
+        .filter_map(|t| t.result.as_ref().ok().filter(|r| r.analysis.quality.is_ok()).map(|r| (t, r)))
+        .flat_map(|(t, r)| {
+            let end = r.law_end.as_ref().map_or(usize::MAX, |(k, _)| *k);
+            let scale = t.spec.lever_arm_m * 1e3 * p_alpha;
+            r.impacts
+                .impacts
+                .iter()
+                .filter(move |i| i.side == Side::Outward && i.k < end)
+                .map(move |i| (i.amplitude_over_alpha, i.speed_before_mm_s / scale))
+        });
+    PushSpeed::of(pushes)
 }
 
 /// Where most of the campaign's tests show finite-duration contacts

@@ -13,6 +13,7 @@ use crate::facade::{calibration_set, normal_or_fixed, CoefficientSet, Im, Study,
 use crate::ground_motion::{Format, ReadOptions, Units};
 use crate::ingest::text::{parse_toml, read_text};
 use crate::limits;
+use crate::restitution_law::LawReading;
 use crate::solver::BlockSpec;
 use crate::wall::housner_e;
 
@@ -106,6 +107,10 @@ struct RawSet {
     /// e_H the law's r is multiplied by (default: Eq. 2 with the block's α, and
     /// with each sample's α in the ensembles).
     e_h: Option<f64>,
+    /// Where the solver reads the law: "amplitude" (default: the apex of the
+    /// half-cycle the impact ends) or "speed" (the amplitude of the campaign's
+    /// impacts of the impact's speed).
+    reading: Option<String>,
 }
 
 /// One distribution of `[uncertainty]`: a number (fixed), `{ normal = [mean, sd] }`
@@ -253,6 +258,9 @@ fn coefficient_set(path: &Path, base: &Path, s: &RawSet, alpha: f64) -> Result<C
     if s.e_h.is_some() {
         return Err(bad(path, format!("[[coefficients]] {:?}: e_h is for a set with a law", s.name)));
     }
+    if s.reading.is_some() {
+        return Err(bad(path, format!("[[coefficients]] {:?}: reading is for a set with a law", s.name)));
+    }
     if s.spread.is_some() && s.calibration.is_none() {
         return Err(bad(
             path,
@@ -313,13 +321,26 @@ fn law_set(path: &Path, base: &Path, s: &RawSet, file: &str, alpha: f64) -> Resu
     if let Some(e_h) = s.e_h.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
         return Err(named(format!("e_h = {e_h}: expected 0 < e_H ≤ 1")));
     }
+    let reading = match s.reading.as_deref() {
+        None | Some("amplitude") => LawReading::Amplitude,
+        Some("speed") => LawReading::Speed,
+        Some(o) => return Err(named(format!("reading = {o:?}: expected \"amplitude\" or \"speed\""))),
+    };
     let law = crate::ingest::law::read(&base.join(file))?;
+    if reading == LawReading::Speed {
+        law.readable_by_speed()
+            .map_err(|why| named(format!("reading = \"speed\": law {file}: {why}")))?;
+    }
     let e_h = match s.e_h {
         Some(e) => format!("e_H = {e}"),
         None => "e_H by Eq. 2".to_string(),
     };
-    let source = format!("law {file} ({}), {e_h}", law.form.as_str());
-    Ok(CoefficientSet::law(&s.name, law, s.e_h, alpha, drawn, source))
+    let read = match reading {
+        LawReading::Amplitude => String::new(),
+        LawReading::Speed => ", read by the impact's speed".to_string(),
+    };
+    let source = format!("law {file} ({}), {e_h}{read}", law.form.as_str());
+    Ok(CoefficientSet::law(&s.name, law, s.e_h, alpha, drawn, source).read_by(reading))
 }
 
 /// A set read from a calibration file, with the spread it asks for.

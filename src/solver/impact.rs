@@ -14,10 +14,14 @@
 //! law ([`crate::restitution_law::RestitutionLaw`], the campaign's fitted law).
 //! e is capped at 1, as [`RestitutionLaw::e`] does (a law read beyond the
 //! amplitudes it was fitted on could otherwise add energy).
+//!
+//! A study may read a law by the impact's speed instead ([`LawReading::Speed`]):
+//! at the amplitude whose campaign impact had the same ŵ = |θ'⁻|/(p α)
+//! (crate::restitution_law, "Reading a law by the impact's speed").
 
 use std::sync::Arc;
 
-use crate::restitution_law::RestitutionLaw;
+use crate::restitution_law::{LawReading, RestitutionLaw};
 use crate::wall::Side;
 
 /// A restitution law as the solver sees it.
@@ -25,19 +29,38 @@ pub trait Restitution: Send + Sync + std::fmt::Debug {
     /// r = e / e_H at an impact entering `entering`, ending a half-cycle of apex
     /// a = |θ|/α.
     fn r(&self, entering: Side, amplitude_over_alpha: f64) -> f64;
+
+    /// The amplitude at which to read the law for an impact entering `entering`
+    /// at the dimensionless speed ŵ = |θ'⁻|/(p α) on a block of slenderness
+    /// `alpha` ([`LawReading::Speed`]); None where the law cannot say, and the
+    /// apex is used.
+    fn amplitude_at_speed(&self, _entering: Side, _speed_over_p_alpha: f64, _alpha: f64) -> Option<f64> {
+        None
+    }
 }
 
-/// A law applied to a block: e = r(side, a) · e_H.
+/// A law applied to a block: e = r(side, a) · e_H, with a read as `reading` says.
 #[derive(Debug, Clone)]
 pub struct ImpactLaw {
     pub law: Arc<dyn Restitution>,
     /// The block's e_H (Eq. 2, or the value a study gives).
     pub e_housner: f64,
+    /// Where the law is read: at the apex (the default) or at the impact's speed.
+    pub reading: LawReading,
 }
 
 impl ImpactLaw {
     pub fn new(law: Arc<dyn Restitution>, e_housner: f64) -> ImpactLaw {
-        ImpactLaw { law, e_housner }
+        ImpactLaw {
+            law,
+            e_housner,
+            reading: LawReading::Amplitude,
+        }
+    }
+
+    /// The same law read as `reading` says.
+    pub fn read_by(self, reading: LawReading) -> ImpactLaw {
+        ImpactLaw { reading, ..self }
     }
 
     /// e = min(1, r(side, a) · e_H).
@@ -45,11 +68,27 @@ impl ImpactLaw {
     pub fn e(&self, entering: Side, amplitude_over_alpha: f64) -> f64 {
         (self.law.r(entering, amplitude_over_alpha) * self.e_housner).min(1.0)
     }
+
+    /// The amplitude the law is read at for an impact that ends a half-cycle of
+    /// apex a = `apex_over_alpha` at ŵ = `speed_over_p_alpha` on a block of
+    /// slenderness `alpha`: the apex's, or (read by speed) the amplitude of the
+    /// campaign's impacts of that speed.
+    #[inline]
+    pub fn read_at(&self, entering: Side, apex_over_alpha: f64, speed_over_p_alpha: f64, alpha: f64) -> f64 {
+        match self.reading {
+            LawReading::Amplitude => apex_over_alpha,
+            LawReading::Speed => self.law.amplitude_at_speed(entering, speed_over_p_alpha, alpha).unwrap_or(apex_over_alpha),
+        }
+    }
 }
 
 /// The campaign's law (`restitution_law` of summary.json) as the solver applies it.
 impl Restitution for RestitutionLaw {
     fn r(&self, entering: Side, amplitude_over_alpha: f64) -> f64 {
         RestitutionLaw::r(self, entering, amplitude_over_alpha)
+    }
+
+    fn amplitude_at_speed(&self, entering: Side, speed_over_p_alpha: f64, alpha: f64) -> Option<f64> {
+        RestitutionLaw::amplitude_at_speed(self, entering, speed_over_p_alpha, alpha)
     }
 }

@@ -152,15 +152,22 @@ impl RockingModel {
             .sum()
     }
 
-    /// The coefficient of an impact entering `entering` that ends a half-cycle of
-    /// apex |θ| = `apex` (rad): the law's min(1, r(side, apex/α)·e_H), else e_in
-    /// or e_out.
+    /// The coefficient of an impact entering `entering` at angular speed
+    /// `omega_before` that ends a half-cycle of apex |θ| = `apex` (rad), and the
+    /// amplitude a law was read at: the law's min(1, r(side, a)·e_H) with a the
+    /// apex/α or, read by speed, [`ImpactLaw::read_at`]'s; else e_in or e_out
+    /// (and the apex/α).
     #[inline]
-    pub fn coefficient(&self, entering: Side, apex: f64) -> f64 {
+    pub fn coefficient(&self, entering: Side, apex: f64, omega_before: f64) -> (f64, f64) {
+        let a = apex / self.alpha;
         match (&self.law, entering) {
-            (Some(law), _) => law.e(entering, apex / self.alpha),
-            (None, Side::Inward) => self.e_in,
-            (None, Side::Outward) => self.e_out,
+            (Some(law), _) => {
+                let w = omega_before.abs() / (self.p2.sqrt() * self.alpha);
+                let read = law.read_at(entering, a, w, self.alpha);
+                (law.e(entering, read), read)
+            }
+            (None, Side::Inward) => (self.e_in, a),
+            (None, Side::Outward) => (self.e_out, a),
         }
     }
 

@@ -130,8 +130,12 @@ pub enum Event {
         v_after: f64,
         /// a = apex/α of the half-cycle the impact ends (max |θ| since the last
         /// impact, uplift or release, over α): the amplitude at which a law's
-        /// coefficient was read.
+        /// coefficient was read when it is read by amplitude.
         amplitude_over_alpha: f64,
+        /// The a at which a law's coefficient was read: `amplitude_over_alpha`,
+        /// or, a law read by speed, the amplitude of the campaign's impacts of
+        /// this impact's speed ([`super::ImpactLaw::read_at`]).
+        law_amplitude_over_alpha: f64,
     },
     /// Rocking started from rest towards `side` (serialised ±1).
     Uplift {
@@ -492,7 +496,7 @@ impl<'a, 'o> Loop<'a, 'o> {
     /// that ends); rest when that leaves the wall slower than the rest speed.
     fn impact(&mut self, from: Side, te: f64, vb: f64, hh: f64) {
         let entering = from.opposite();
-        let e = self.model.coefficient(entering, self.apex);
+        let (e, law_amplitude_over_alpha) = self.model.coefficient(entering, self.apex, vb);
         let amplitude_over_alpha = self.apex / self.model.alpha;
         self.apex = 0.0;
         let va = e * vb;
@@ -504,6 +508,7 @@ impl<'a, 'o> Loop<'a, 'o> {
             v_before: vb,
             v_after: va,
             amplitude_over_alpha,
+            law_amplitude_over_alpha,
         });
         self.t = te;
         self.y = [0.0, va];

@@ -687,7 +687,8 @@ fn facade_law_set_read_by_speed() {
     let with = r#", "push_speed": {"median": 1000000.0, "range": [1000000.0, 1000000.0], "impacts": 4}"#;
     std::fs::write(dir.path().join("law.json"), law(with)).unwrap();
     std::fs::write(dir.path().join("old.json"), law("")).unwrap();
-    let sets = "\n[[coefficients]]\nname = \"by a\"\nlaw = \"law.json\"\n\n[[coefficients]]\nname = \"by speed\"\nlaw = \"law.json\"\nreading = \"speed\"\n";
+    let sets =
+        "\n[[coefficients]]\nname = \"by a\"\nlaw = \"law.json\"\n\n[[coefficients]]\nname = \"by speed\"\nlaw = \"law.json\"\nreading = \"speed\"\n";
     let study = write_study(dir.path(), &(SMALL_STUDY.to_string() + sets));
     let out = dir.path().join("out");
     let o = facade(&study, &out, &[]);
@@ -709,11 +710,23 @@ fn facade_law_set_read_by_speed() {
         md.lines().any(|l| l.contains("by speed") && l.contains("read by the impact's speed")),
         "{md}"
     );
-    assert!(!md.lines().any(|l| l.contains("**by a**") && l.contains("read by the impact's speed")), "{md}");
+    assert!(
+        !md.lines().any(|l| l.contains("**by a**") && l.contains("read by the impact's speed")),
+        "{md}"
+    );
     let cases = [
-        (sets.replace("law = \"law.json\"\nreading", "law = \"old.json\"\nreading"), "\"by speed\": reading = \"speed\": law old.json"),
-        (sets.replace("reading = \"speed\"", "reading = \"sideways\""), "expected \"amplitude\" or \"speed\""),
-        ("\n[[coefficients]]\nname = \"pair\"\ne = 0.9\nreading = \"speed\"\n".to_string(), "reading is for a set with a law"),
+        (
+            sets.replace("law = \"law.json\"\nreading", "law = \"old.json\"\nreading"),
+            "\"by speed\": reading = \"speed\": law old.json",
+        ),
+        (
+            sets.replace("reading = \"speed\"", "reading = \"sideways\""),
+            "expected \"amplitude\" or \"speed\"",
+        ),
+        (
+            "\n[[coefficients]]\nname = \"pair\"\ne = 0.9\nreading = \"speed\"\n".to_string(),
+            "reading is for a set with a law",
+        ),
     ];
     for (sets, expect) in cases {
         let study = write_study(dir.path(), &(SMALL_STUDY.to_string() + &sets));

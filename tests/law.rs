@@ -1051,9 +1051,14 @@ fn push_speed_against_the_engine_speeds() {
     let pushes: Vec<_> = r.impacts.impacts.iter().filter(|i| i.side == Side::Outward && i.k < end).collect();
     for i in &pushes {
         let v = peaks[i.k]["velocity_mm_s"].as_f64().unwrap().abs();
-        println!("k{} a {:.4}: {:.2} mm/s read, {v:.2} mm/s true", i.k, i.amplitude_over_alpha, i.speed_before_mm_s);
+        println!(
+            "k{} a {:.4}: {:.2} mm/s read, {v:.2} mm/s true",
+            i.k, i.amplitude_over_alpha, i.speed_before_mm_s
+        );
     }
-    let ratios = pushes.iter().map(|i| (i.amplitude_over_alpha, peaks[i.k]["velocity_mm_s"].as_f64().unwrap().abs() / scale));
+    let ratios = pushes
+        .iter()
+        .map(|i| (i.amplitude_over_alpha, peaks[i.k]["velocity_mm_s"].as_f64().unwrap().abs() / scale));
     let want = rocklab::restitution_law::PushSpeed::of(ratios).unwrap();
     let got = res.law.as_ref().unwrap().law.parameters.push_speed.expect("a one-sided law carries Ω/p");
     println!("push_speed {got:?} against the truth's {want:?}");

@@ -490,7 +490,10 @@ fn a_law_read_by_speed_reads_free_arcs_at_their_apex_and_pushes_at_their_speed()
     assert!(y.len() >= 10 && y.iter().take(10).all(|i| i.1 > 1e-3), "{y:?}");
     for (k, (p, q)) in x.iter().zip(&y).take(10).enumerate() {
         assert!((q.2 / q.1 - 1.0).abs() < 1e-9, "impact {k}: read at {} for apex {}", q.2, q.1);
-        assert!((q.3 / p.3 - 1.0).abs() < 1e-9 && (q.4 / p.4 - 1.0).abs() < 1e-9, "impact {k}: {p:?} vs {q:?}");
+        assert!(
+            (q.3 / p.3 - 1.0).abs() < 1e-9 && (q.4 / p.4 - 1.0).abs() < 1e-9,
+            "impact {k}: {p:?} vs {q:?}"
+        );
     }
 
     let (k_theta, q_campaign) = (60.0, 9.0);
@@ -521,7 +524,10 @@ fn a_law_read_by_speed_reads_free_arcs_at_their_apex_and_pushes_at_their_speed()
             Side::Outward => (gravity + k_theta / P2 * a * a).sqrt() / q_campaign,
             Side::Inward => a,
         };
-        assert!((read / want - 1.0).abs() < 1e-9, "impact {k} ({side:?}): read at {read}, want {want} (apex {a})");
+        assert!(
+            (read / want - 1.0).abs() < 1e-9,
+            "impact {k} ({side:?}): read at {read}, want {want} (apex {a})"
+        );
         let e = one_sided.e(side, read, 0.95);
         assert!((va / vb / e - 1.0).abs() < 1e-9, "impact {k}: e {} vs {e}", va / vb);
     }

@@ -370,7 +370,9 @@ fn law_reading_of(reading: Option<&str>, law: Option<&RestitutionLaw>) -> anyhow
     };
     match law {
         None if reading.is_some() => bail!("law_reading is for a law"),
-        Some(l) if r == LawReading::Speed => l.readable_by_speed().map_err(|why| anyhow::anyhow!("law_reading = \"speed\": the law: {why}"))?,
+        Some(l) if r == LawReading::Speed => l
+            .readable_by_speed()
+            .map_err(|why| anyhow::anyhow!("law_reading = \"speed\": the law: {why}"))?,
         _ => {}
     }
     Ok(r)

@@ -14,9 +14,9 @@ use crate::ingest::manifest::{Campaign, TestSpec};
 use crate::ingest::LogReader;
 use crate::law_fit::{fit_law, LawFit, LawFitError, TestImpacts};
 use crate::peaks::{ContactModel, Method, Onset, PeakOptions, Physics};
+pub use crate::reduction::{LogData, ReduceError, Reduced};
 use crate::restitution_law::PushSpeed;
 use crate::wall::{Rocking, Side};
-pub use crate::reduction::{LogData, ReduceError, Reduced};
 
 /// Why a test of a campaign has no coefficients.
 #[derive(Debug, thiserror::Error)]
@@ -216,7 +216,9 @@ fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, La
             (t.spec.id.as_str(), table)
         })
         .collect();
-    let push_speed = (campaign.rocking == Rocking::OneSided).then(|| campaign_push_speed(campaign, tests)).flatten();
+    let push_speed = (campaign.rocking == Rocking::OneSided)
+        .then(|| campaign_push_speed(campaign, tests))
+        .flatten();
     let used: Vec<TestImpacts> = used.iter().map(|(id, table)| TestImpacts { id, table }).collect();
     fit_law(campaign.rocking, &used).map(|fit| fit.with_push_speed(push_speed))
 }

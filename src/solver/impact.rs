@@ -77,7 +77,10 @@ impl ImpactLaw {
     pub fn read_at(&self, entering: Side, apex_over_alpha: f64, speed_over_p_alpha: f64, alpha: f64) -> f64 {
         match self.reading {
             LawReading::Amplitude => apex_over_alpha,
-            LawReading::Speed => self.law.amplitude_at_speed(entering, speed_over_p_alpha, alpha).unwrap_or(apex_over_alpha),
+            LawReading::Speed => self
+                .law
+                .amplitude_at_speed(entering, speed_over_p_alpha, alpha)
+                .unwrap_or(apex_over_alpha),
         }
     }
 }

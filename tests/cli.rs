@@ -320,7 +320,20 @@ fn demo_writes_tables_and_plots() {
         if fitted["form"] != "constant" {
             sets.push(constant);
         }
+        // Both one-sided laws carry their pushes' Ω/p (read by speed).
+        let q = &fitted["parameters"]["push_speed"];
+        let (lo, median, hi) = (
+            q["range"][0].as_f64().unwrap(),
+            q["median"].as_f64().unwrap(),
+            q["range"][1].as_f64().unwrap(),
+        );
+        assert!(
+            0.0 < lo && lo <= median && median <= hi && q["impacts"].as_u64().unwrap() >= 3,
+            "{c}: {q}"
+        );
     }
+    // The engine campaign's law read by the impact's speed as well.
+    sets.push("mujoco law by speed");
     // The truth's law is a speed-loss law outward (tests/law.rs): both its sets run.
     sets.extend(["mujoco truth law", "mujoco truth constant"]);
     assert_eq!(rows.len(), 3 * 2 * sets.len(), "records × polarities × sets");

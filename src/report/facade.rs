@@ -230,7 +230,9 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
             if two {
                 let ratio = (row.len() >= 2).then(|| row[1].summary.max_theta_over_alpha / row[0].summary.max_theta_over_alpha);
                 cells.push(match ratio {
-                    Some(x) if row.iter().all(|r| !r.summary.overturned) => Cell::num(x, format!("{:.0}%", 100.0 * x)),
+                    // The ratio of the first two sets' peaks, where neither overturned
+                    // (a set further along the row has no say in it).
+                    Some(x) if row[..2].iter().all(|r| !r.summary.overturned) => Cell::num(x, format!("{:.0}%", 100.0 * x)),
                     _ => Cell::text("—"),
                 });
             }

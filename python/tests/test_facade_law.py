@@ -106,10 +106,9 @@ def test_an_energy_term_of_zero_is_the_speed_loss_law_bit_for_bit():
 def test_a_law_read_by_speed():
     """law_reading="speed": each impact reads the law at the amplitude of the
     campaign's impacts of its speed. A law whose outward side ends pushes needs
-    the campaign's Ω/p (push_speed); the summary says how the law was read. With
-    Ω/p so large that every outward impact reads the push law at the floor, the
-    push law takes all the outward speed (r = 0 there): the run differs from the
-    amplitude reading's."""
+    the campaign's Ω/p (push_speed); the summary says how the law was read, and
+    each impact event the amplitude it was read at: the apex's by amplitude, and
+    with Ω/p = 10⁹ an outward impact's ŵ/10⁹ (below 1e-8 here), by speed."""
     law = json.loads(LAW.read_text())
     law["parameters"]["out"]["g"] = "push"
     with pytest.raises(rocklab.RocklabError, match="push_speed"):
@@ -122,5 +121,9 @@ def test_a_law_read_by_speed():
     by_a = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, history=False)
     by_w = rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="speed", history=False)
     assert (by_a["law"]["reading"], by_w["law"]["reading"]) == ("amplitude", "speed")
-    assert by_a["impacts"] > 2
-    assert by_w["max_theta_over_alpha"] != by_a["max_theta_over_alpha"]
+    impacts = lambda res, side: [e for e in res["events"] if e["kind"] == "impact" and e["entering"] == side]
+    assert len(impacts(by_a, 1)) > 2 and len(impacts(by_w, 1)) > 2
+    assert all(e["law_amplitude_over_alpha"] == e["amplitude_over_alpha"] for e in impacts(by_a, 1) + impacts(by_a, -1))
+    outward = impacts(by_w, 1)
+    assert all(e["law_amplitude_over_alpha"] < 1e-8 for e in outward)
+    assert max(e["amplitude_over_alpha"] for e in outward) > 1e-6

@@ -720,7 +720,8 @@ fn facade_law_set_read_by_speed() {
     }
     let md = std::fs::read_to_string(out.join("results.md")).unwrap();
     assert!(
-        md.lines().any(|l| l.contains("by speed") && l.contains("read by the impact's speed")),
+        md.lines().any(|l| l.contains("by speed") && l.contains("read by the impact's speed"))
+            && md.contains("For by speed (read by the impact's speed), a is the amplitude"),
         "{md}"
     );
     assert!(

@@ -276,6 +276,23 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun], ensemble: Option<&[Ense
         "in its nominal runs (every record and polarity)"
     };
     let caption = format!("Where each law set's impacts fell {whose}, by the side they enter:") + " the amplitudes a = |θ|/α of the campaign's impacts the law was fitted on, those of the runs' impacts, and how many of these ended a half-cycle smaller or larger than any the campaign observed on that side (there the law's coefficient comes from its form, extrapolated or held, not from a measured impact), with in brackets their share of the kinetic energy the side's impacts met (Σ θ'² before impact: most impacts of a run that comes to rest are tiny and carry almost none), or were capped at e = 1 (an elastic impact), and the mean e the side's impacts applied, weighted by that energy. A verdict whose impacts lie beyond the data rests on the law's form there, not on the campaign.";
+    // A set read by the impact's speed reads its law at the amplitude of the
+    // campaign's impacts of that speed, not at the run's apex: say so.
+    let by_speed: Vec<&str> = study
+        .sets
+        .iter()
+        .filter(|s| s.law_reading() == crate::restitution_law::LawReading::Speed)
+        .map(|s| s.name.as_str())
+        .collect();
+    let caption = if by_speed.is_empty() {
+        caption
+    } else {
+        caption
+            + &format!(
+                " For {} (read by the impact's speed), a is the amplitude each impact read the law at: that of the campaign's impacts of its speed, not the run's apex.",
+                by_speed.join(", ")
+            )
+    };
     let mut t = Table::new("law_reach", caption, columns);
     t.nowrap = true;
     // n of `of` impacts, with a share in brackets (of the impacts or of the energy).

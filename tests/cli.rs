@@ -728,6 +728,17 @@ fn facade_law_set_read_by_speed() {
         !md.lines().any(|l| l.contains("**by a**") && l.contains("read by the impact's speed")),
         "{md}"
     );
+    // The sets say how the façade's restraint compares with the campaign's pushes
+    // (the block's Ω/p is 148.3; this law's pushes 10⁶): read at the apex, the
+    // law is read where the campaign's pushes were 10⁶/148.3 = 6743 times faster.
+    assert!(
+        md.contains("its pushes were measured at Ω/p = 1000000.0 (1000000.0–1000000.0), this block's restraint gives 148.3: read at the apex, an outward impact reads the law where the campaign's pushes were 674"),
+        "{md}"
+    );
+    assert!(
+        md.contains("this block's restraint gives 148.3: each impact reads the law at its speed"),
+        "{md}"
+    );
     let cases = [
         (
             sets.replace("law = \"law.json\"\nreading", "law = \"old.json\"\nreading"),

@@ -163,11 +163,19 @@ def case_inputs(rng, sandbox):
         # A coefficient set read from a restitution law file (a law alone or a
         # summary.json holding one), the file mutated; drawn in the ensembles.
         law = (FIX / "facade" / "law.json").read_text()
+        # Half of them a one-sided law with its pushes' Ω/p, read by the impact's
+        # speed (fifty-seventh session).
+        by_speed = rng.random() < 0.5
+        if by_speed:
+            doc = json.loads(law)
+            doc["parameters"]["out"]["g"] = "push"
+            doc["parameters"]["push_speed"] = {"median": 16.9, "range": [13.5, 18.0], "impacts": 13}
+            law = json.dumps(doc, indent=1)
         if rng.random() < 0.5:
             law = '{"campaign": "c", "restitution_law": ' + law + "}"
         (work / "f" / "law.json").write_text(law)
         desc = mutate_file(rng, work / "f" / "law.json", rng.choice(["toml", "text"]))
-        study += '\n[[coefficients]]\nname = "law"\nlaw = "law.json"\n'
+        study += '\n[[coefficients]]\nname = "law"\nlaw = "law.json"\n' + ('reading = "speed"\n' if by_speed else "")
         (work / "f" / "study.toml").write_text(study)
         return kind, f"law.json {desc}", ["facade", str(work / "f" / "study.toml"), "--out", str(out)]
     (work / "f" / "study.toml").write_text(study)

@@ -8,6 +8,7 @@ use super::table::{to_html, to_markdown, Align, Cell, Column, Table};
 use super::{csv_bytes, Files, InputFile, ReportError};
 use crate::facade::{CoefficientSet, EnsembleRow, IdaPoint, SampleRun, SetFragility, Study, StudyRun};
 use crate::outcomes::{find_run, ida_curve, ida_fractions, polarity_key};
+use crate::restitution_law::LawReading;
 
 type Result<T> = std::result::Result<T, ReportError>;
 
@@ -195,7 +196,7 @@ pub fn results_table(study: &Study, runs: &[StudyRun]) -> Table {
         .map(|s| {
             let law = match s.law_at(study.block.block.alpha) {
                 Some((law, e_h)) => {
-                    let range = law_range(&law, e_h);
+                    let range = law_range(&law, e_h, s.law_reading(), study.block.push_speed_ratio());
                     format!(", the law's e at a = 1{}{range}", if range.is_empty() { "" } else { "; " })
                 }
                 None => String::new(),
@@ -281,7 +282,7 @@ pub fn law_reach_table(study: &Study, runs: &[StudyRun], ensemble: Option<&[Ense
     let by_speed: Vec<&str> = study
         .sets
         .iter()
-        .filter(|s| s.law_reading() == crate::restitution_law::LawReading::Speed)
+        .filter(|s| s.law_reading() == LawReading::Speed)
         .map(|s| s.name.as_str())
         .collect();
     let caption = if by_speed.is_empty() {
@@ -601,7 +602,7 @@ fn ensemble_caption(study: &Study) -> String {
     let sets = study
         .sets
         .iter()
-        .map(|s| format!("{} {}", s.name, describe_set(s, study.block.block.alpha)))
+        .map(|s| format!("{} {}", s.name, describe_set(s, &study.block)))
         .collect::<Vec<_>>()
         .join("; ");
     format!(
@@ -613,7 +614,13 @@ fn ensemble_caption(study: &Study) -> String {
 /// Where a law set's coefficients sit at the cap: per side, the amplitude from which
 /// the solver's e = min(1, r(a) e_H) is 1 (a perfectly elastic impact), beside the
 /// amplitudes of the campaign's impacts (a speed-loss law; a constant has none).
-fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64) -> String {
+///
+/// Where the law's outward side ends pushes and carries the campaign's Ω/p, it
+/// also says how the block's restraint compares (`block_push`, the block's Ω/p):
+/// read at the apex, a push of the block reads the law where the campaign's pushes
+/// were (Ω/p)_block/(Ω/p)_campaign times slower (docs/facade.md, "Reading the law
+/// by the impact's speed").
+fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64, reading: LawReading, block_push: Option<f64>) -> String {
     use crate::restitution_law::LawForm;
     use crate::wall::Side;
     let (lo, hi) = (law.parameters.amplitude_min, law.parameters.amplitude_max);
@@ -626,12 +633,29 @@ fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64) -> String {
             parts.push(format!("{name} e = 1 (the cap: an elastic impact) from a = {a:.3}"));
         }
     }
+    if let (true, Some(q), Some(qb)) = (law.ends_a_push(Side::Outward), law.parameters.push_speed, block_push) {
+        let measured = format!(
+            "its pushes were measured at Ω/p = {:.1} ({:.1}–{:.1}), this block's restraint gives {qb:.1}",
+            q.median, q.range[0], q.range[1]
+        );
+        parts.push(match reading {
+            LawReading::Amplitude => {
+                let (x, how) = if qb >= q.median { (qb / q.median, "slower") } else { (q.median / qb, "faster") };
+                format!("{measured}: read at the apex, an outward impact reads the law where the campaign's pushes were {x:.1} times {how} (reading = \"speed\" reads it at its speed)")
+            }
+            LawReading::Speed => format!("{measured}: each impact reads the law at its speed"),
+        });
+    }
     parts.join("; ")
 }
 
-fn describe_set(s: &CoefficientSet, alpha: f64) -> String {
+fn describe_set(s: &CoefficientSet, block: &crate::solver::BlockSpec) -> String {
     use crate::ensemble::CoefficientDist;
-    let range = match s.law_at(alpha).map(|(law, e_h)| law_range(&law, e_h)) {
+    let alpha = block.block.alpha;
+    let range = match s
+        .law_at(alpha)
+        .map(|(law, e_h)| law_range(&law, e_h, s.law_reading(), block.push_speed_ratio()))
+    {
         Some(r) if !r.is_empty() => format!("; {r}"),
         _ => String::new(),
     };

@@ -58,6 +58,19 @@ pub struct BlockSpec {
     pub overrides: Vec<String>,
 }
 
+impl BlockSpec {
+    /// Ω/p of the inward restraint: the angular frequency of a push against it,
+    /// Ω = √(k_θ/I₀), over p (where the spring dominates gravity, a push of apex a
+    /// ends at ω⁻ ≈ Ω a α); None without a restraint. A law's pushes were measured
+    /// at the campaign's Ω/p ([`crate::restitution_law::PushSpeed`]).
+    pub fn push_speed_ratio(&self) -> Option<f64> {
+        match self.restraint {
+            Restraint::Rotational { k_nm_per_rad } => Some((k_nm_per_rad / self.block.i0 / self.block.p2()).sqrt()),
+            Restraint::None => None,
+        }
+    }
+}
+
 /// Optional impact defaults of a block file.
 #[derive(Debug, Clone, Copy, Default, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -78,5 +91,25 @@ mod tests {
         assert!((b.p2() - 3.0 * G / (4.0 * b.r_m)).abs() < 1e-12);
         assert!((b.r_m - 3.8409).abs() < 1e-4);
         assert!((b.alpha - 0.10437).abs() < 1e-4);
+    }
+
+    /// The façade's nominal block (fixtures/facade/block.toml: K'_c 750 MN/m² over
+    /// 7.64 m, I₀ = 4/3 m R² with R = 3.84 m): k_θ = K'_c h³/3 and
+    /// Ω/p = √(k_θ/(I₀ p²)), the 148.3 that tools/facade_push_transfer.py printed
+    /// (fifty-sixth session) from the same file in Python.
+    #[test]
+    fn push_speed_ratio_of_a_spring_bed() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/block.toml");
+        let spec = BlockSpec::load(&path).unwrap();
+        let (k, h) = spec.spring_bed.unwrap();
+        let want = (k * 1e6 * h.powi(3) / 3.0 / spec.block.i0 / spec.block.p2()).sqrt();
+        let got = spec.push_speed_ratio().unwrap();
+        assert!((got / want - 1.0).abs() < 1e-12, "{got} vs {want}");
+        assert!((got - 148.3).abs() < 0.05, "{got}");
+        let free = BlockSpec {
+            restraint: Restraint::None,
+            ..spec
+        };
+        assert_eq!(free.push_speed_ratio(), None);
     }
 }

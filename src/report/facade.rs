@@ -633,7 +633,9 @@ fn law_range(law: &crate::restitution_law::RestitutionLaw, e_h: f64, reading: La
             parts.push(format!("{name} e = 1 (the cap: an elastic impact) from a = {a:.3}"));
         }
     }
-    if let (true, Some(q), Some(qb)) = (law.ends_a_push(Side::Outward), law.parameters.push_speed, block_push) {
+    // (A constant reads the same e at every amplitude: nothing to say.)
+    let pushes = law.form != LawForm::Constant && law.ends_a_push(Side::Outward);
+    if let (true, Some(q), Some(qb)) = (pushes, law.parameters.push_speed, block_push) {
         let measured = format!(
             "its pushes were measured at Ω/p = {:.1} ({:.1}–{:.1}), this block's restraint gives {qb:.1}",
             q.median, q.range[0], q.range[1]

@@ -23,17 +23,24 @@ fn facade_ensemble_10000_runs(bencher: divan::Bencher) {
 
 /// Issue 20: 2,400 runs of the fixture study with its calibrated pair, or with the
 /// same pair as a constant restitution law whose r carries the pair's spread
-/// (r = e/e_H, u = sd/e_H: statistically the same runs), each sample drawing it.
-#[divan::bench(args = ["pair", "law"], sample_count = 3)]
+/// (r = e/e_H, u = sd/e_H: statistically the same runs), each sample drawing it;
+/// "law-by-speed" reads that law at each impact's speed (the same e: what the
+/// reading itself costs).
+#[divan::bench(args = ["pair", "law", "law-by-speed"], sample_count = 3)]
 fn facade_ensemble_2400_runs_pair_or_law(bencher: divan::Bencher, how: &str) {
     use rocklab::facade::CoefficientSet;
     use rocklab::restitution_law::RestitutionLaw;
     let mut study = Study::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/facade/study.toml")).unwrap();
     let e_h = study.e_housner_eq2;
     study.sets.retain(|s| s.name == "calibrated");
-    if how == "law" {
+    if how != "pair" {
         let law = RestitutionLaw::constant(0.59 / e_h, 0.017 / e_h, 0.68 / e_h, 0.025 / e_h);
-        study.sets = vec![CoefficientSet::law("law", law, Some(e_h), study.block.block.alpha, true, "bench".into())];
+        let set = CoefficientSet::law("law", law, Some(e_h), study.block.block.alpha, true, "bench".into());
+        let reading = match how {
+            "law-by-speed" => rocklab::restitution_law::LawReading::Speed,
+            _ => rocklab::restitution_law::LawReading::Amplitude,
+        };
+        study.sets = vec![set.read_by(reading)];
     }
     let n = 2400 / (study.records.len() * study.rows().len());
     bencher.bench(|| {

@@ -157,9 +157,13 @@ impl CoefficientSet {
         }
     }
 
-    /// The same law set read as `reading` says (a pair is left as it is).
+    /// The same law set read as `reading` says, its source saying so where it is
+    /// read by speed (a pair is left as it is).
     pub fn read_by(mut self, reading: LawReading) -> CoefficientSet {
         if let CoefficientDist::Law { reading: r, .. } = &mut self.dist {
+            if reading == LawReading::Speed && *r != reading {
+                self.source.push_str(", read by the impact's speed");
+            }
             *r = reading;
         }
         self

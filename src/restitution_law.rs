@@ -100,9 +100,9 @@
 //! What it assumes: the lost Δω scales with the wall's own p α (c is dimensionless
 //! in those units), and a push's ŵ/a is one number (on the public one-sided
 //! campaign its 13 pushes give 13.5–18.0 around a median 16.9: the gravity term
-//! and the compliant restraint make it vary). Neither reading can be checked against measured impacts of a façade;
-//! docs/facade.md, "Reading the law by the impact's speed", gives what the choice
-//! does to the demo's verdicts.
+//! and the compliant restraint make it vary). Neither reading can be checked
+//! against measured impacts of a façade; docs/facade.md, "Reading the law by the
+//! impact's speed", gives what the choice does to the demo's verdicts.
 //!
 //! # Uncertainty and draws
 //! u(r(a))² = ∇ᵀ Σ ∇ with ∇ = (1, −g(a)) and Σ the side's 2×2 covariance of (r∞, c)
@@ -432,22 +432,17 @@ impl PushSpeed {
     /// From the outward impacts' (amplitude a, ŵ): the median and range of ŵ/a
     /// over those with a > 0 and ŵ > 0 (None without any).
     pub fn of(impacts: impl IntoIterator<Item = (f64, f64)>) -> Option<PushSpeed> {
-        let mut q: Vec<f64> = impacts
+        let q: Vec<f64> = impacts
             .into_iter()
             .filter(|(a, w)| *a > 0.0 && *w > 0.0 && a.is_finite() && w.is_finite())
             .map(|(a, w)| w / a)
             .collect();
-        q.sort_by(f64::total_cmp);
-        let n = q.len();
-        let median = match n {
-            0 => return None,
-            _ if n % 2 == 1 => q[n / 2],
-            _ => 0.5 * (q[n / 2 - 1] + q[n / 2]),
-        };
+        let q = crate::stats::sorted(&q);
+        let (first, last) = (*q.first()?, *q.last()?);
         Some(PushSpeed {
-            median,
-            range: [q[0], q[n - 1]],
-            impacts: n,
+            median: crate::stats::quantile_sorted(&q, 0.5),
+            range: [first, last],
+            impacts: q.len(),
         })
     }
 }
@@ -467,6 +462,15 @@ pub enum LawReading {
 }
 
 impl LawReading {
+    /// "amplitude" or "speed", as a study file or Python names it.
+    pub fn parse(text: &str) -> Option<LawReading> {
+        match text {
+            "amplitude" => Some(LawReading::Amplitude),
+            "speed" => Some(LawReading::Speed),
+            _ => None,
+        }
+    }
+
     pub fn as_str(self) -> &'static str {
         match self {
             LawReading::Amplitude => "amplitude",
@@ -670,7 +674,7 @@ impl RestitutionLaw {
     /// [`PushSpeed`].
     pub fn readable_by_speed(&self) -> Result<(), String> {
         if self.ends_a_push(Side::Outward) && self.parameters.push_speed.is_none() {
-            return Err("its outward side ends pushes, and it carries no parameters.push_speed (the campaign's Ω/p, written by rocklab reduce since the fifty-seventh session): reduce the campaign again, or read it by amplitude".into());
+            return Err("its outward side ends pushes, and it carries no parameters.push_speed (the campaign's Ω/p, which rocklab reduce writes with a one-sided law): reduce the campaign again with this rocklab, or read the law by amplitude".into());
         }
         Ok(())
     }

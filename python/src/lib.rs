@@ -363,10 +363,10 @@ fn load_law(path: Option<PathBuf>, json_text: Option<String>, e_h: Option<f64>, 
 /// Where `simulate` reads a law: "amplitude" (default) or "speed" (a law whose
 /// outward side ends pushes needs the campaign's Ω/p for it).
 fn law_reading_of(reading: Option<&str>, law: Option<&RestitutionLaw>) -> anyhow::Result<LawReading> {
-    let r = match reading {
-        None | Some("amplitude") => LawReading::Amplitude,
-        Some("speed") => LawReading::Speed,
-        Some(o) => bail!("law_reading = {o:?}: expected \"amplitude\" or \"speed\""),
+    let r = match reading.map(|r| (r, LawReading::parse(r))) {
+        None => LawReading::Amplitude,
+        Some((_, Some(r))) => r,
+        Some((o, None)) => bail!("law_reading = {o:?}: expected \"amplitude\" or \"speed\""),
     };
     match law {
         None if reading.is_some() => bail!("law_reading is for a law"),

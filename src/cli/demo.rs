@@ -43,7 +43,6 @@ pub fn run(args: DemoArgs) -> anyhow::Result<ExitCode> {
     if let Some(law_set) = study.sets.iter().find(|s| s.name == "mujoco law").filter(readable) {
         let mut by_speed = law_set.clone().read_by(rocklab::restitution_law::LawReading::Speed);
         by_speed.name = "mujoco law by speed".into();
-        by_speed.source.push_str(", read by the impact's speed");
         study.sets.push(by_speed);
     }
     // The law the engine's own per-impact truth gives (what the readings would give

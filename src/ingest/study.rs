@@ -321,10 +321,10 @@ fn law_set(path: &Path, base: &Path, s: &RawSet, file: &str, alpha: f64) -> Resu
     if let Some(e_h) = s.e_h.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
         return Err(named(format!("e_h = {e_h}: expected 0 < e_H ≤ 1")));
     }
-    let reading = match s.reading.as_deref() {
-        None | Some("amplitude") => LawReading::Amplitude,
-        Some("speed") => LawReading::Speed,
-        Some(o) => return Err(named(format!("reading = {o:?}: expected \"amplitude\" or \"speed\""))),
+    let reading = match s.reading.as_deref().map(|r| (r, LawReading::parse(r))) {
+        None => LawReading::Amplitude,
+        Some((_, Some(r))) => r,
+        Some((o, None)) => return Err(named(format!("reading = {o:?}: expected \"amplitude\" or \"speed\""))),
     };
     let law = crate::ingest::law::read(&base.join(file))?;
     if reading == LawReading::Speed {
@@ -335,11 +335,7 @@ fn law_set(path: &Path, base: &Path, s: &RawSet, file: &str, alpha: f64) -> Resu
         Some(e) => format!("e_H = {e}"),
         None => "e_H by Eq. 2".to_string(),
     };
-    let read = match reading {
-        LawReading::Amplitude => String::new(),
-        LawReading::Speed => ", read by the impact's speed".to_string(),
-    };
-    let source = format!("law {file} ({}), {e_h}{read}", law.form.as_str());
+    let source = format!("law {file} ({}), {e_h}", law.form.as_str());
     Ok(CoefficientSet::law(&s.name, law, s.e_h, alpha, drawn, source).read_by(reading))
 }
 

@@ -70,17 +70,17 @@ impl ImpactLaw {
     }
 
     /// The amplitude the law is read at for an impact that ends a half-cycle of
-    /// apex a = `apex_over_alpha` at ŵ = `speed_over_p_alpha` on a block of
-    /// slenderness `alpha`: the apex's, or (read by speed) the amplitude of the
-    /// campaign's impacts of that speed.
+    /// apex a = `apex_over_alpha` at angular speed `omega_before` on a block of
+    /// slenderness `alpha` and p = `p`: the apex's, or (read by speed) the
+    /// amplitude of the campaign's impacts of its ŵ = |ω⁻|/(p α).
     #[inline]
-    pub fn read_at(&self, entering: Side, apex_over_alpha: f64, speed_over_p_alpha: f64, alpha: f64) -> f64 {
+    pub fn read_at(&self, entering: Side, apex_over_alpha: f64, omega_before: f64, p: f64, alpha: f64) -> f64 {
         match self.reading {
             LawReading::Amplitude => apex_over_alpha,
-            LawReading::Speed => self
-                .law
-                .amplitude_at_speed(entering, speed_over_p_alpha, alpha)
-                .unwrap_or(apex_over_alpha),
+            LawReading::Speed => {
+                let w = omega_before.abs() / (p * alpha);
+                self.law.amplitude_at_speed(entering, w, alpha).unwrap_or(apex_over_alpha)
+            }
         }
     }
 }

@@ -162,8 +162,7 @@ impl RockingModel {
         let a = apex / self.alpha;
         match (&self.law, entering) {
             (Some(law), _) => {
-                let w = omega_before.abs() / (self.p2.sqrt() * self.alpha);
-                let read = law.read_at(entering, a, w, self.alpha);
+                let read = law.read_at(entering, a, omega_before, self.p2.sqrt(), self.alpha);
                 (law.e(entering, read), read)
             }
             (None, Side::Inward) => (self.e_in, a),

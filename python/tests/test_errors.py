@@ -1,6 +1,7 @@
 """Bad input raises RocklabError with the CLI's message; a panic never crashes the
 interpreter."""
 
+import math
 import threading
 import time
 
@@ -136,8 +137,13 @@ def test_panic_becomes_an_exception():
 def test_long_calls_release_the_gil():
     """While one thread runs a batch in Rust, another thread keeps running Python:
     its longest pause is well under the call's duration (a held GIL would stop it
-    for the whole call)."""
+    for the whole call). The batch is sized on this machine first, to last about a
+    second alone, so a fast or a loaded machine cannot make it too short to tell."""
     runs = rocklab.plan_facade(STUDY, scales=[0.5, 1.0, 1.5])
+    t0 = time.perf_counter()
+    rocklab.facade_runs(STUDY, runs, sensitivity=True, parallel=False)
+    alone = time.perf_counter() - t0
+    runs = runs * max(1, math.ceil(1.0 / max(alone, 1e-3)))
     done = threading.Event()
     took = []
 

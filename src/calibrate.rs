@@ -39,6 +39,10 @@ pub struct CampaignInput<'a> {
     pub rocking: Rocking,
     pub wall: Wall,
     pub tests: Vec<TestInput<'a>>,
+    /// Ω/p of a one-sided campaign's pushes as the reduction measured it (None
+    /// two-sided, or with no push read): the law by replay carries it, so that it
+    /// can be read by the impact's speed as the law from the readings can.
+    pub push_speed: Option<crate::restitution_law::PushSpeed>,
 }
 
 /// Why a test has no fit.
@@ -984,6 +988,7 @@ mod tests {
                 lever_arm_m: 2.33,
                 reduced: Err(&err),
             }],
+            push_speed: None,
         };
         let cal = calibrate(&input, 6);
         assert_eq!(

@@ -47,7 +47,7 @@ use std::sync::Arc;
 use crate::calibrate::{nuisance_of, replay_with, steps_nuisance, window_to, CampaignInput, Geometry, Nuisance, TestFit, TestWindow};
 use crate::fit::{least_squares, FitResult, FitStop};
 use crate::reduction::Reduced;
-use crate::restitution_law::{speed_shape, LawForm, LawParameters, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
+use crate::restitution_law::{speed_shape, LawForm, LawParameters, PushSpeed, RestitutionLaw, Shape, SideLaw, AMPLITUDE_FLOOR};
 use crate::solver::impact::ImpactLaw;
 
 /// How the calibration fits the restitution law (issue 20; `law_by_replay` in
@@ -444,8 +444,10 @@ fn campaign_side(tests: &[TestLawReplay], k: usize, span: (f64, f64)) -> SideRep
     verdict(s[0].side, m, cov, cst, span)
 }
 
-/// The law the verdicts give.
-fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
+/// The law the verdicts give; a one-sided law carries the campaign's Ω/p
+/// (`push_speed`, [`CampaignInput::push_speed`]): its outward impacts end pushes,
+/// and a study that reads it by speed reads them at that Ω/p.
+fn law_of(sides: &[SideReplay], span: (f64, f64), push_speed: Option<PushSpeed>) -> RestitutionLaw {
     let side = |s: &SideReplay| {
         if s.separated {
             SideLaw {
@@ -478,7 +480,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64)) -> RestitutionLaw {
             amplitude_max: span.1.clamp(span.0.max(AMPLITUDE_FLOOR), 1.0),
             inward_amplitude_min: None,
             observed: None,
-            push_speed: None,
+            push_speed: push_speed.filter(|_| sides.len() == 2),
         },
     }
 }
@@ -551,7 +553,7 @@ pub fn fit_law_by_replay(c: &CampaignInput, fits: &[TestFit], included: &[String
         tests.iter().map(|t| t.amplitude_max).fold(0.0, f64::max),
     );
     let sides: Vec<SideReplay> = (0..tests[0].sides.len()).map(|k| campaign_side(&tests, k, span)).collect();
-    let law = law_of(&sides, span);
+    let law = law_of(&sides, span, c.push_speed);
     let readings = against_readings(c, included, &law);
     let mut notes = notes(&sides, span);
     if let Some((n, rms, mean)) = readings {
@@ -604,6 +606,7 @@ mod tests {
     }
 
     use super::*;
+    use crate::wall::Side;
 
     /// Crossings with hysteresis, the apex of each half-cycle, and the stop at a
     /// half-cycle below the tall level.
@@ -626,6 +629,30 @@ mod tests {
         // A taller level stops before the apex-5 half-cycle.
         assert_eq!(half_cycles(&t, &x, 0.0, 1.0, 5.5, 10).len(), 2);
         assert_eq!(half_cycles(&t, &x, 0.0, 1.0, 3.0, 1).len(), 1);
+    }
+
+    /// A one-sided law by replay carries the campaign's Ω/p, so that a study can
+    /// read it by speed (its outward impacts end pushes); a two-sided one does
+    /// not, and a one-sided law with it passes `readable_by_speed`, where it
+    /// would be refused without it once a side changes with the amplitude.
+    #[test]
+    fn a_one_sided_law_by_replay_carries_the_campaign_push_speed() {
+        let q = PushSpeed::of([(0.02, 0.34), (0.03, 0.5)]).unwrap();
+        let mut side = super::verdict("in", [0.7, 0.0], [[1e-4, 0.0], [0.0, 1e-8]], (0.7, 0.01), (0.01, 0.3));
+        side.separated = false;
+        let mut out = side.clone();
+        out.side = "out";
+        (out.separated, out.r_inf, out.c) = (true, 1.02, 0.004);
+        let one = law_of(&[side.clone(), out.clone()], (0.01, 0.3), Some(q));
+        assert_eq!(one.parameters.push_speed, Some(q));
+        assert!(one.ends_a_push(Side::Outward));
+        one.readable_by_speed().unwrap();
+        let mut bare = one;
+        bare.parameters.push_speed = None;
+        assert!(bare.readable_by_speed().is_err());
+        let two = law_of(&[out], (0.01, 0.3), Some(q));
+        assert_eq!(two.parameters.push_speed, None);
+        two.readable_by_speed().unwrap();
     }
 
     /// The campaign mean: sample covariance / n.

@@ -95,7 +95,11 @@
 //!   rocking both readings agree;
 //! - push: a = ŵ/(Ω/p)_campaign, with the campaign's median ŵ/a over the outward
 //!   impacts its law was fitted on ([`PushSpeed`], `parameters.push_speed`,
-//!   measured by `reduce` from each impact's speed before and amplitude).
+//!   measured by `reduce` from each impact's speed before and amplitude; the law
+//!   by replay of `calibrate` carries the same). Where a law has sides fitted
+//!   apart, an outward side that changes with the amplitude and no Ω/p, whether
+//!   its outward impacts end pushes cannot be told, and it is not read by speed
+//!   ([`RestitutionLaw::readable_by_speed`]).
 //!
 //! What it assumes: the lost Δω scales with the wall's own p α (c is dimensionless
 //! in those units), and a push's ŵ/a is one number (on the public one-sided
@@ -671,10 +675,20 @@ impl RestitutionLaw {
     }
 
     /// Whether the law can be read by speed: a push side needs the campaign's
-    /// [`PushSpeed`].
+    /// [`PushSpeed`]. A law whose sides are fitted apart (`shared` false: a
+    /// one-sided wall's) without it, whose outward side changes with the amplitude,
+    /// is refused too: its outward impacts may end pushes (a one-sided law by
+    /// replay, or one written by hand), and read on the free arc they would be
+    /// read at the wrong amplitude without a word. A constant side reads the same
+    /// e either way.
     pub fn readable_by_speed(&self) -> Result<(), String> {
-        if self.ends_a_push(Side::Outward) && self.parameters.push_speed.is_none() {
+        let p = &self.parameters;
+        if self.ends_a_push(Side::Outward) && p.push_speed.is_none() {
             return Err("its outward side ends pushes, and it carries no parameters.push_speed (the campaign's Ω/p, which rocklab reduce writes with a one-sided law): reduce the campaign again with this rocklab, or read the law by amplitude".into());
+        }
+        let outward_varies = p.outward.c != 0.0 || p.outward.energy.is_some();
+        if !p.shared && p.push_speed.is_none() && outward_varies {
+            return Err("its sides are fitted apart (shared = false, a one-sided wall's law) and it carries no parameters.push_speed: rocklab cannot tell whether its outward impacts end pushes, which are read at the campaign's Ω/p, or free arcs; give the law its campaign's push_speed (rocklab reduce and rocklab calibrate write it with a one-sided law), or read the law by amplitude".into());
         }
         Ok(())
     }
@@ -1220,6 +1234,21 @@ mod tests {
         let mut c = RestitutionLaw::constant(0.6, 0.01, 0.9, 0.01);
         assert!(!c.ends_a_push(Side::Outward));
         c.readable_by_speed().unwrap();
+        // Sides fitted apart with a free-arc outward curve and no Ω/p (a one-sided
+        // law by replay written before, or by hand): which impacts end pushes
+        // cannot be told, so it is refused; shared, or with its Ω/p, it is read.
+        let mut apart = l;
+        apart.parameters.push_speed = None;
+        apart.parameters.outward.g = Shape::Free;
+        let err = apart.readable_by_speed().unwrap_err();
+        assert!(err.contains("shared = false") && err.contains("push_speed"), "{err}");
+        apart.parameters.push_speed = Some(q);
+        apart.readable_by_speed().unwrap();
+        assert_eq!(apart.amplitude_at_speed(Side::Outward, 4.25, 0.1), Some(0.25));
+        apart.parameters.push_speed = None;
+        apart.parameters.shared = true;
+        apart.parameters.inward = apart.parameters.outward;
+        apart.readable_by_speed().unwrap();
         c.parameters.push_speed = Some(q);
         assert!(c.ends_a_push(Side::Outward));
         // JSON: written and read back; refused out of order, with the key named.

@@ -33,6 +33,10 @@ def test_calibrate_equals_cli(cli, tmp_path):
     law = res.summary["calibration"]["law_replay"]
     assert sorted([t["id"] for t in law["tests"]] + [f[0] for f in law["failed"]]) == sorted(expected["calibration"]["included"])
     assert law["notes"] and law["law"]["form"] in ("constant", "speed-loss")
+    # A one-sided law by replay carries the campaign's Ω/p, as the law from the
+    # readings does, so that a study can read it by the impact's speed.
+    push = expected["restitution_law"]["parameters"]["push_speed"]
+    assert push["impacts"] > 0 and law["law"]["parameters"]["push_speed"] == push
 
 
 def test_facade_equals_cli_summary_and_ida(cli, tmp_path):

@@ -99,6 +99,9 @@ impl CampaignResult {
                     reduced: t.result.as_ref().map_err(|e| e as &(dyn std::error::Error + Sync)),
                 })
                 .collect(),
+            push_speed: (self.campaign.rocking == Rocking::OneSided)
+                .then(|| campaign_push_speed(&self.campaign, &self.tests))
+                .flatten(),
         }
     }
 }

@@ -700,6 +700,9 @@ fn facade_law_set_read_by_speed() {
     let with = r#", "push_speed": {"median": 1000000.0, "range": [1000000.0, 1000000.0], "impacts": 4}"#;
     std::fs::write(dir.path().join("law.json"), law(with)).unwrap();
     std::fs::write(dir.path().join("old.json"), law("")).unwrap();
+    // Sides fitted apart, a free-arc outward curve, no Ω/p (a one-sided law by
+    // replay written before it carried one): which impacts end pushes cannot be told.
+    std::fs::write(dir.path().join("apart.json"), law("").replace(", \"g\": \"push\"", "")).unwrap();
     let sets =
         "\n[[coefficients]]\nname = \"by a\"\nlaw = \"law.json\"\n\n[[coefficients]]\nname = \"by speed\"\nlaw = \"law.json\"\nreading = \"speed\"\n";
     let study = write_study(dir.path(), &(SMALL_STUDY.to_string() + sets));
@@ -743,6 +746,10 @@ fn facade_law_set_read_by_speed() {
         (
             sets.replace("law = \"law.json\"\nreading", "law = \"old.json\"\nreading"),
             "\"by speed\": reading = \"speed\": law old.json",
+        ),
+        (
+            sets.replace("law = \"law.json\"\nreading", "law = \"apart.json\"\nreading"),
+            "its sides are fitted apart (shared = false",
         ),
         (
             sets.replace("reading = \"speed\"", "reading = \"sideways\""),

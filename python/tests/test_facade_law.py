@@ -110,6 +110,10 @@ def test_a_law_read_by_speed():
     each impact event the amplitude it was read at: the apex's by amplitude, and
     with Ω/p = 10⁹ an outward impact's ŵ/10⁹ (below 1e-8 here), by speed."""
     law = json.loads(LAW.read_text())
+    # Sides fitted apart, a free-arc outward curve and no Ω/p: whether its outward
+    # impacts end pushes cannot be told, so it is not read by speed.
+    with pytest.raises(rocklab.RocklabError, match="shared = false"):
+        rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="speed")
     law["parameters"]["out"]["g"] = "push"
     with pytest.raises(rocklab.RocklabError, match="push_speed"):
         rocklab.simulate(BLOCK, NRC_1030, scale=1.27, law=law, law_reading="speed")

@@ -693,6 +693,11 @@ pub struct SetFragility {
     #[serde(serialize_with = "fit_or_error")]
     pub fit: Result<Fragility, FragilityError>,
     pub observed: Vec<Trial>,
+    /// A law set's fragility: [`LawReach`] summed over every run it was fitted
+    /// to, the IDA's scales included, where the larger scales rock the façade
+    /// beyond the amplitudes the campaign observed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law_reach: Option<LawReach>,
 }
 
 fn fit_or_error<S: serde::Serializer>(fit: &Result<Fragility, FragilityError>, ser: S) -> Result<S::Ok, S::Error> {
@@ -737,6 +742,10 @@ pub fn fragility_by_set(study: &Study, runs: &[SampleRun]) -> Vec<SetFragility> 
                 coefficients: set.name.clone(),
                 fit: fit_lognormal(&trials),
                 observed,
+                law_reach: mine.iter().filter_map(|r| r.law_reach).reduce(|mut a, b| {
+                    a.add(&b);
+                    a
+                }),
             }
         })
         .collect()

@@ -348,8 +348,37 @@ fn demo_writes_tables_and_plots() {
     }
     let fits = s["fragility"]["sets"].as_array().unwrap();
     assert_eq!(fits.len(), sets.len());
+    let table = stdout.split("Lognormal fragility").next().unwrap_or_default();
     for f in fits {
         assert!(f["fit"].get("median").is_some() || f["fit"].get("error").is_some(), "{f}");
+        // A law set's fragility says where its runs, every scale of the IDA
+        // included, read the law against its data; its row is marked ‡ exactly
+        // where one side met more than half of its energy beyond them.
+        let name = f["coefficients"].as_str().unwrap();
+        let reach = &f["law_reach"];
+        assert_eq!(reach.is_null(), ["housner", "calibrated", "campaign"].contains(&name), "{name}: {reach}");
+        if reach.is_null() {
+            continue;
+        }
+        let beyond = ["inward", "outward"]
+            .iter()
+            .map(|k| &reach[k])
+            .filter(|x| x["energy"].as_f64().unwrap() > 0.0)
+            .map(|x| (x["energy_below"].as_f64().unwrap() + x["energy_above"].as_f64().unwrap()) / x["energy"].as_f64().unwrap())
+            .fold(0.0, f64::max);
+        let runs: u64 = f["observed"].as_array().unwrap().iter().map(|t| t["n"].as_u64().unwrap()).sum();
+        assert!(
+            reach["inward"]["impacts"].as_u64().unwrap() + reach["outward"]["impacts"].as_u64().unwrap() >= runs,
+            "{name}: {reach}"
+        );
+        // The fragility table is the last before its caption; the law-reach
+        // table's rows, which also start with the set, come before it.
+        let marked = table
+            .lines()
+            .rev()
+            .find(|l| l.starts_with(&format!("| {name} | ")) || l.starts_with(&format!("| {name} ‡ | ")))
+            .unwrap_or_else(|| panic!("{name}: no fragility row in {stdout}"));
+        assert_eq!(marked.starts_with(&format!("| {name} ‡ |")), beyond > 0.5, "{name}: {beyond} {marked}");
     }
     assert_eq!(&std::fs::read(f.join("fragility.png")).unwrap()[..8], b"\x89PNG\r\n\x1a\n");
     let html = std::fs::read_to_string(f.join("report.html")).unwrap();

@@ -788,13 +788,24 @@ fn fragility_table(study: &Study, fits: &[SetFragility], source: &str) -> Table 
         "Lognormal fragility P(overturn | IM) = Φ(ln(IM/θ)/β) fitted by maximum likelihood (Baker 2015) to every run of {source}; IM = {im} of the scaled record each run felt. 95 % intervals from the observed information (Wald on ln θ and ln β); they treat the runs as independent, so with {} records they understate the record-to-record uncertainty.",
         study.records.len()
     );
+    let beyond = |f: &SetFragility| f.law_reach.is_some_and(|x| x.beyond_share() > BEYOND_THE_DATA);
+    let caption = if fits.iter().any(beyond) {
+        caption
+            + &format!(
+                " ‡ a law set whose runs, the larger scales included, met together more than {:.0} % of one side's impact energy at amplitudes the campaign did not observe on that side: its fragility rests on the law's form there, not on measured impacts.",
+                100.0 * BEYOND_THE_DATA
+            )
+    } else {
+        caption
+    };
     let mut t = Table::new("fragility", caption, columns);
     t.nowrap = true;
     for f in fits {
         let runs: usize = f.observed.iter().map(|t| t.n).sum();
+        let name = format!("{}{}", f.coefficients, if beyond(f) { " ‡" } else { "" });
         let cells = match &f.fit {
             Ok(x) => vec![
-                Cell::text(&f.coefficients),
+                Cell::text(&name),
                 Cell::num(x.median, format!("{:.3}", x.median)),
                 Cell::text(format!("{:.3}–{:.3}", x.median_ci95[0], x.median_ci95[1])),
                 Cell::num(x.beta, format!("{:.3}", x.beta)),
@@ -802,7 +813,7 @@ fn fragility_table(study: &Study, fits: &[SetFragility], source: &str) -> Table 
                 Cell::text(x.runs.to_string()),
             ],
             Err(e) => vec![
-                Cell::text(&f.coefficients),
+                Cell::text(&name),
                 Cell::text(format!("no fit: {e}")),
                 Cell::default(),
                 Cell::default(),

@@ -99,9 +99,7 @@ impl CampaignResult {
                     reduced: t.result.as_ref().map_err(|e| e as &(dyn std::error::Error + Sync)),
                 })
                 .collect(),
-            push_speed: (self.campaign.rocking == Rocking::OneSided)
-                .then(|| campaign_push_speed(&self.campaign, &self.tests))
-                .flatten(),
+            push_speed: campaign_push_speed(&self.campaign, &self.tests),
         }
     }
 }
@@ -219,17 +217,19 @@ fn campaign_law(campaign: &Campaign, tests: &[TestOutcome]) -> Result<LawFit, La
             (t.spec.id.as_str(), table)
         })
         .collect();
-    let push_speed = (campaign.rocking == Rocking::OneSided)
-        .then(|| campaign_push_speed(campaign, tests))
-        .flatten();
+    let push_speed = campaign_push_speed(campaign, tests);
     let used: Vec<TestImpacts> = used.iter().map(|(id, table)| TestImpacts { id, table }).collect();
     fit_law(campaign.rocking, &used).map(|fit| fit.with_push_speed(push_speed))
 }
 
 /// Ω/p of a one-sided campaign's pushes ([`PushSpeed`]): ŵ/a of the outward
 /// impacts the law is fitted on, ŵ = v/(L p α) with v the sensor's speed before
-/// the impact, L the test's lever arm and p, α the wall's rocking part.
+/// the impact, L the test's lever arm and p, α the wall's rocking part. None for
+/// a two-sided campaign (no pushes) or one with no push read.
 fn campaign_push_speed(campaign: &Campaign, tests: &[TestOutcome]) -> Option<PushSpeed> {
+    if campaign.rocking != Rocking::OneSided {
+        return None;
+    }
     let part = campaign.wall().rocking_part();
     let p_alpha = part.p_squared().sqrt() * part.slenderness();
     let pushes = tests

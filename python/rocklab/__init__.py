@@ -537,7 +537,11 @@ class EnsembleResult:
         samples: one row per sample (its drawn inputs and outcome); for a law set
             ``e_in``/``e_out`` are the drawn law's e at a = 1.
         fragility: one row per set (``median``, ``beta`` and their intervals, or
-            ``error`` when no fit is possible), or None when there is nothing to fit.
+            ``error`` when no fit is possible; for a law set ``beyond_the_data``,
+            the largest share of one side's impact energy its runs met at
+            amplitudes the campaign did not observe, the report's ‡ above 0.5,
+            None for other sets; the counts in ``doc``'s ``law_reach``), or None
+            when there is nothing to fit.
         fragility_source: "ida" (fitted to the IDA's samples) or "ensemble".
         doc: the whole document.
     """
@@ -578,7 +582,7 @@ def facade_ensembles(
     frag = doc["fragility"]
     fits = None
     if frag is not None:
-        fits = _frame([dict(coefficients=s["coefficients"], **s["fit"]) for s in frag["sets"]])
+        fits = _frame([dict(coefficients=s["coefficients"], **s["fit"], beyond_the_data=_beyond_the_data(s.get("law_reach"))) for s in frag["sets"]])
     return EnsembleResult(
         rows=_frame(_scalar_columns(doc["rows"])),
         samples=_frame(_scalar_columns(doc["samples"])),
@@ -586,6 +590,15 @@ def facade_ensembles(
         fragility_source=None if frag is None else frag["source"],
         doc=doc,
     )
+
+
+def _beyond_the_data(reach: Optional[dict]) -> Optional[float]:
+    """The largest share of one side's impact energy met below or above a law's
+    data (``LawReach::beyond_share``), None without a law."""
+    if reach is None:
+        return None
+    shares = [(x["energy_below"] + x["energy_above"]) / x["energy"] for x in (reach["inward"], reach["outward"]) if x["energy"] > 0]
+    return max(shares, default=0.0)
 
 
 def _run_rows(runs: list) -> list:

@@ -5,6 +5,7 @@ import json
 import shutil
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import rocklab
@@ -66,6 +67,13 @@ def test_facade_ensembles_equal_cli(cli, tmp_path):
     assert [s["fit"] for s in res.doc["fragility"]["sets"]] == [s["fit"] for s in expected["fragility"]["sets"]]
     assert res.fragility_source == "ida"
     assert list(res.fragility["coefficients"]) == ["housner", "calibrated", "law"]
+    # The law set's fragility says where its runs, every scale included, read the
+    # law against its data, as the CLI's summary does; the pairs carry nothing.
+    reach = [s.get("law_reach") for s in res.doc["fragility"]["sets"]]
+    assert reach == [s.get("law_reach") for s in expected["fragility"]["sets"]]
+    assert reach[0] is None and reach[1] is None and reach[2]["outward"]["impacts"] > 0
+    beyond = list(res.fragility["beyond_the_data"])
+    assert pd.isna(beyond[0]) and pd.isna(beyond[1]) and 0.0 <= beyond[2] <= 1.0
     assert len(res.rows) == 3 * 2 * 3 and len(res.samples) == 3 * 2 * 3 * 4
     law_samples = res.samples[res.samples["coefficients"] == "law"]
     assert law_samples["e_out"].nunique() > 1, "the law's parameters are drawn per sample"

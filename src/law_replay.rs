@@ -643,7 +643,7 @@ mod tests {
         let mut out = side.clone();
         out.side = "out";
         (out.separated, out.r_inf, out.c) = (true, 1.02, 0.004);
-        let one = law_of(&[side.clone(), out.clone()], (0.01, 0.3), Some(q));
+        let one = law_of(&[side, out.clone()], (0.01, 0.3), Some(q));
         assert_eq!(one.parameters.push_speed, Some(q));
         assert!(one.ends_a_push(Side::Outward));
         one.readable_by_speed().unwrap();

@@ -582,7 +582,7 @@ def facade_ensembles(
     frag = doc["fragility"]
     fits = None
     if frag is not None:
-        fits = _frame([dict(coefficients=s["coefficients"], **s["fit"], beyond_the_data=_beyond_the_data(s.get("law_reach"))) for s in frag["sets"]])
+        fits = _frame([dict(coefficients=s["coefficients"], **s["fit"], beyond_the_data=s.get("beyond_the_data")) for s in frag["sets"]])
     return EnsembleResult(
         rows=_frame(_scalar_columns(doc["rows"])),
         samples=_frame(_scalar_columns(doc["samples"])),
@@ -590,15 +590,6 @@ def facade_ensembles(
         fragility_source=None if frag is None else frag["source"],
         doc=doc,
     )
-
-
-def _beyond_the_data(reach: Optional[dict]) -> Optional[float]:
-    """The largest share of one side's impact energy met below or above a law's
-    data (``LawReach::beyond_share``), None without a law."""
-    if reach is None:
-        return None
-    shares = [(x["energy_below"] + x["energy_above"]) / x["energy"] for x in (reach["inward"], reach["outward"]) if x["energy"] > 0]
-    return max(shares, default=0.0)
 
 
 def _run_rows(runs: list) -> list:

@@ -443,6 +443,22 @@ fn facade(py: Python<'_>, study: PathBuf, scales: Option<Vec<f64>>) -> PyResult<
     Ok(doc.to_string())
 }
 
+/// The fragility fits of `runs` as summary.json writes them, each law set's with
+/// `beyond_the_data`, the share behind the report's ‡ (`LawReach::beyond_share`).
+fn fragility_sets(study: &Study, runs: &[rocklab::facade::SampleRun]) -> Vec<serde_json::Value> {
+    fragility_by_set(study, runs)
+        .into_iter()
+        .map(|f| {
+            let beyond = f.law_reach.map(|x| x.beyond_share());
+            let mut v = json!(f);
+            if let (Some(b), Some(o)) = (beyond, v.as_object_mut()) {
+                o.insert("beyond_the_data".into(), json!(b));
+            }
+            v
+        })
+        .collect()
+}
+
 /// The façade's ensembles and fragility, as `rocklab facade` computes them
 /// (without the nominal runs): the ensemble rows and samples at scale 1 (when the
 /// study has samples), and a lognormal fragility per set fitted to the IDA's
@@ -476,9 +492,9 @@ fn facade_ensembles(
         let fragility = match &scales {
             Some(sc) => {
                 let ida = run_ida_samples(&study, sc, study.ida_samples, &|| {})?;
-                Some(json!({"source": "ida", "scales": sc, "sets": fragility_by_set(&study, &ida), "samples": ida}))
+                Some(json!({"source": "ida", "scales": sc, "sets": fragility_sets(&study, &ida), "samples": ida}))
             }
-            None if !ens.is_empty() && study.records.len() >= 2 => Some(json!({"source": "ensemble", "sets": fragility_by_set(&study, &ens)})),
+            None if !ens.is_empty() && study.records.len() >= 2 => Some(json!({"source": "ensemble", "sets": fragility_sets(&study, &ens)})),
             None => None,
         };
         Ok(json!({

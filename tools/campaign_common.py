@@ -6,7 +6,7 @@ m/s, theta in rad, height of the higher toe above the bedding in m). This module
 those into a campaign: the truth's velocity peaks (the extreme of the sensor's
 horizontal velocity within each half-cycle between zero crossings of theta), the
 tables' values (paper Eqs. 3-6), the logger (random phase, Gaussian noise, linear
-drift, 0.01 mm quantisation, sampled at fs) and the files (campaign.toml, one CSV per
+drift, 0.01 mm quantisation unless `--noise-mm` sets the noise, sampled at fs) and the files (campaign.toml, one CSV per
 test, truth.json), in the format the Rust tests read (tests/truth.rs,
 tests/local_readings.rs, tests/law.rs).
 """
@@ -84,6 +84,11 @@ def write_campaign(p, out, how, rng, simulate, engine, script, toml_header):
         # Logger: a random phase, from 1 s before the release to 3 s after the motion ends.
         sigma = rng.uniform(0.01, 0.04)
         drift = rng.uniform(-0.2, 0.2)
+        # --noise-mm: the same draws (the stream is unchanged), another noise and no
+        # quantisation: what the readings' model form costs without the logger's noise.
+        quant = 0.01
+        if p.get("noise_mm") is not None:
+            sigma, quant = p["noise_mm"], None
         t_start = t_rel - 1.0 + rng.uniform(0, 1 / fs)
         t_end = min(a[-1, 0], cross[-1] + 3.0)
         ts = np.arange(t_start, t_end, 1 / fs)
@@ -91,19 +96,20 @@ def write_campaign(p, out, how, rng, simulate, engine, script, toml_header):
         xs = np.interp(ts, a[:, 0], a[:, 1]) - x_rest
         xs = 1000.0 * xs
         xs += rng.normal(0, sigma, len(ts)) + drift * (ts - ts[0]) / (ts[-1] - ts[0])
-        xs = np.round(xs / 0.01) * 0.01
+        if quant is not None:
+            xs = np.round(xs / quant) * quant
         t_file = ts - ts[0]
         with open(os.path.join(out, f"{tid}.csv"), "w") as f:
             f.write(f"# campaign: {name}\n# test: {tid}\n# sampling_rate_Hz: {fs}\n")
             f.write(f"# channels: time_s [s]; disp_mm [mm] LVDT at {p['L']:.2f} m, positive = outward\n")
             f.write("time_s,disp_mm\n")
             for ti, xi in zip(t_file, xs):
-                f.write(f"{ti:.6f},{xi:.2f}\n")
+                f.write(f"{ti:.6f},{xi:.2f}\n" if quant is not None else f"{ti:.6f},{xi:.6f}\n")
         pk = [dict(k=q["k"], time_s=a[q["i"], 0] - ts[0], velocity_mm_s=q["velocity_mm_s"]) for q in peaks]
         v = [q["velocity_mm_s"] for q in pk]
         tab = tables(v, e_h)
         sim.update(**engine, fs_Hz=fs, sigma_mm=sigma, drift_mm=drift,
-                   quant_mm=0.01, x0_mm_nominal=x0, theta0_rad=theta0, t_release_s=t_rel - ts[0],
+                   quant_mm=quant, x0_mm_nominal=x0, theta0_rad=theta0, t_release_s=t_rel - ts[0],
                    zero_crossings_s=[c - ts[0] for c in cross], rocking_mass_kg=mass,
                    lift_fraction_per_half_cycle=lift)
         tests.append(dict(id=tid, file=f"{tid}.csv", exclude_from_mean=False, sim=sim, peaks=pk,
@@ -161,6 +167,9 @@ def cli(presets, make, resimulate, check=None):
                          "other beddings, restraints, noise and drift for the same wall and tests")
     if check is not None:
         ap.add_argument("--check", action="store_true", help="the engine's own checks")
+    ap.add_argument("--noise-mm", type=float, default=None,
+                    help="the logger's noise (mm) in place of the drawn one, and no 0.01 mm "
+                         "quantisation; every other draw as without it")
     ap.add_argument("--resimulate", metavar="TEST", help="run TEST of the campaign in --out again")
     ap.add_argument("--trace", help="where --resimulate writes the trajectory")
     args = ap.parse_args()
@@ -176,4 +185,7 @@ def cli(presets, make, resimulate, check=None):
     seed = p["seed"] if args.seed is None else args.seed
     rng = np.random.default_rng(seed)
     how = f"--preset {args.preset}" + ("" if args.seed is None else f" --seed {args.seed}")
+    if args.noise_mm is not None:
+        p = dict(p, noise_mm=args.noise_mm)
+        how += f" --noise-mm {args.noise_mm:g}"
     make(p, args.out, how, rng)

@@ -14,6 +14,10 @@ with a damped compliant contact (a lossy inward restraint). Same engine set-up a
 
 `--seed` replaces the preset's seed (other beddings, restraints, noise and drift for the
 same wall and tests); a draw whose wall stops rocking before peak 6 is refused.
+`--noise-mm S` keeps every draw of the seed but sets the logger's noise to S mm and
+drops the 0.01 mm quantisation (the file keeps 6 decimals): what the readings' model
+form costs without the noise (docs/restitution-law.md, "Where the pushes' low readings
+come from").
 
 `--resimulate TEST` runs one test of the campaign in `--out` again from the draws stored
 in its truth.json `sim` block (the preset must be the one that made it) and writes the

@@ -62,10 +62,13 @@ def main():
     t, v, th, walls, toe = a.T
     i0 = int(np.searchsorted(t, t_rel))
     cross = [i for i in range(i0 + 1, len(t)) if th[i - 1] * th[i] < 0]
-    ms = lambda i: 1000.0 * (t[i] - t[ic])
     for n, ic in enumerate(cross[:12]):
         if th[ic - 1] >= 0:
             continue
+
+        def ms(i, ic=ic):
+            return 1000.0 * (t[i] - t[ic])
+
         seg = range(cross[n - 1] if n > 0 else i0, ic + 1)
         peak = max(seg, key=lambda j: v[j])
         held = [j for j in seg if walls[j] > 0]

@@ -463,6 +463,7 @@ fn law_of(sides: &[SideReplay], span: (f64, f64), push_speed: Option<PushSpeed>)
     };
     let (i, o) = (side(&sides[0]), side(sides.last().unwrap_or(&sides[0])));
     let any = sides.iter().any(|s| s.separated);
+    let shared = sides.len() == 1;
     let strip = |l: SideLaw| {
         if any {
             l
@@ -475,12 +476,12 @@ fn law_of(sides: &[SideReplay], span: (f64, f64), push_speed: Option<PushSpeed>)
         parameters: LawParameters {
             inward: strip(i),
             outward: strip(o),
-            shared: sides.len() == 1,
+            shared,
             amplitude_min: span.0.max(AMPLITUDE_FLOOR),
             amplitude_max: span.1.clamp(span.0.max(AMPLITUDE_FLOOR), 1.0),
             inward_amplitude_min: None,
             observed: None,
-            push_speed: push_speed.filter(|_| sides.len() == 2),
+            push_speed: push_speed.filter(|_| !shared),
         },
     }
 }
